@@ -1,0 +1,73 @@
+//! The local shading frame (Mitsuba's: `z` = surface normal towards the exterior) and the
+//! plane-of-incidence working frame of [`crate::modes`].
+
+use nalgebra::Vector3;
+
+/// The plane-of-incidence frame expressed in the local frame: working `x` = `u` (direction of the
+/// tangential wave vector), working `y` = `s = ẑ × u` (the s direction), working `z` = `ẑ`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlaneFrame {
+    /// Unit tangential propagation direction (local frame, `u.z = 0`).
+    pub u: Vector3<f64>,
+    /// Unit s direction `ẑ × u` (local frame).
+    pub s: Vector3<f64>,
+}
+
+impl PlaneFrame {
+    /// The frame for light arriving from the azimuth `phi` (radians): the direction towards the
+    /// light is `(sin θ cos φ, sin θ sin φ, ±cos θ)`, so the tangential propagation direction is
+    /// `u = −(cos φ, sin φ, 0)`. Defined for every θ, normal incidence included.
+    pub fn from_azimuth(phi: f64) -> Self {
+        Self::from_u(Vector3::new(-phi.cos(), -phi.sin(), 0.0))
+    }
+
+    /// The frame for light arriving from the local direction `towards_light` (either
+    /// hemisphere). At normal incidence the s direction falls back to `(1, 0, 0)`, as in
+    /// Mitsuba's `dielectric`.
+    pub fn from_direction(towards_light: Vector3<f64>) -> Self {
+        let t = Vector3::new(-towards_light.x, -towards_light.y, 0.0);
+        let n = t.norm();
+        if n > 0.0 {
+            Self::from_u(t / n)
+        } else {
+            Self::from_u(Vector3::new(0.0, -1.0, 0.0))
+        }
+    }
+
+    fn from_u(u: Vector3<f64>) -> Self {
+        PlaneFrame {
+            u,
+            s: Vector3::z().cross(&u),
+        }
+    }
+
+    /// Local → working coordinates.
+    pub fn to_working(&self, v: Vector3<f64>) -> Vector3<f64> {
+        Vector3::new(v.dot(&self.u), v.dot(&self.s), v.z)
+    }
+
+    /// Working → local coordinates.
+    pub fn to_local(&self, v: Vector3<f64>) -> Vector3<f64> {
+        self.u * v.x + self.s * v.y + Vector3::z() * v.z
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn round_trip_and_handedness() {
+        for phi in [0.0, 0.3, 2.0, -1.2] {
+            let f = PlaneFrame::from_azimuth(phi);
+            assert!((f.u.cross(&f.s) - Vector3::z()).norm() < 1e-15);
+            let v = Vector3::new(0.3, -0.5, 0.8);
+            assert!((f.to_local(f.to_working(v)) - v).norm() < 1e-15);
+        }
+        let f = PlaneFrame::from_direction(Vector3::z());
+        assert_eq!(f.s, Vector3::x());
+        let w = Vector3::new(0.5_f64.sin(), 0.0, 0.5_f64.cos());
+        let f = PlaneFrame::from_direction(w);
+        assert!((f.u - Vector3::new(-1.0, 0.0, 0.0)).norm() < 1e-15);
+    }
+}

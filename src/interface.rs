@@ -1,0 +1,114 @@
+//! One planar interface between two homogeneous (isotropic or uniaxial) media: the 4x4
+//! boundary system (seed eqs. S17-S18) solved once for waves arriving from either side, and the
+//! power ratios (seed eq. S19).
+//!
+//! The upper medium fills `z > 0`, the lower one `z < 0` (working frame of [`crate::modes`]).
+//! Tangential `E` and `H` are continuous across `z = 0`; writing every field as a sum of modes,
+//! `Ψ₁↓ a + Ψ₁↑ b = Ψ₂↓ c + Ψ₂↑ d` with the known incoming amplitudes `a` (from above) and `d`
+//! (from below). Solving `[Ψ₁↑ −Ψ₂↓] [b; c] = [−Ψ₁↓ Ψ₂↑] [a; d]` gives the full scattering
+//! matrix `S` of the interface: `[b; c] = S [a; d]`. This one solve covers iso→aniso,
+//! aniso→iso and aniso→aniso interfaces alike.
+
+use crate::error::{Error, Result};
+use crate::medium::Uniaxial;
+use crate::modes::{modes, Mode, ModeSet};
+use nalgebra::{Matrix2, Matrix4};
+use num_complex::Complex64 as C64;
+
+/// The solved interface for one incidence parameter.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Interface {
+    /// Modes of the upper medium.
+    pub upper: ModeSet,
+    /// Modes of the lower medium.
+    pub lower: ModeSet,
+    /// Scattering matrix: rows `[up₁ (2); down₂ (2)]`, columns `[down₁ (2); up₂ (2)]`.
+    pub s: Matrix4<C64>,
+}
+
+/// Writes `sign ×` the tangential fields of two modes into columns `offset`, `offset + 1`.
+fn put(m: &mut Matrix4<C64>, offset: usize, pair: &[Mode; 2], sign: f64) {
+    for (j, mode) in pair.iter().enumerate() {
+        for (i, f) in mode.tangential().iter().enumerate() {
+            m[(i, offset + j)] = f * sign;
+        }
+    }
+}
+
+impl Interface {
+    /// Solves the interface between `upper` and `lower` (axes in the working frame) for the
+    /// incidence parameter `beta`.
+    pub fn new(upper: &Uniaxial, lower: &Uniaxial, beta: C64) -> Result<Self> {
+        Self::from_modes(modes(upper, beta), modes(lower, beta))
+    }
+
+    /// Solves the boundary system for given mode sets (seed eq. S18).
+    pub fn from_modes(upper: ModeSet, lower: ModeSet) -> Result<Self> {
+        let mut lhs = Matrix4::zeros();
+        let mut rhs = Matrix4::zeros();
+        put(&mut lhs, 0, &upper.up, 1.0);
+        put(&mut lhs, 2, &lower.down, -1.0);
+        put(&mut rhs, 0, &upper.down, -1.0);
+        put(&mut rhs, 2, &lower.up, 1.0);
+        let s = lhs.lu().solve(&rhs).ok_or_else(singular)?;
+        if s.iter().any(|z| !z.re.is_finite() || !z.im.is_finite()) {
+            return Err(singular());
+        }
+        Ok(Interface { upper, lower, s })
+    }
+
+    /// Reflection of waves arriving from above: `up₁ ← down₁` (rows/cols in mode order).
+    pub fn r_above(&self) -> Matrix2<C64> {
+        self.s.fixed_view::<2, 2>(0, 0).into_owned()
+    }
+
+    /// Transmission of waves arriving from above: `down₂ ← down₁`.
+    pub fn t_above(&self) -> Matrix2<C64> {
+        self.s.fixed_view::<2, 2>(2, 0).into_owned()
+    }
+
+    /// Transmission of waves arriving from below: `up₁ ← up₂`.
+    pub fn t_below(&self) -> Matrix2<C64> {
+        self.s.fixed_view::<2, 2>(0, 2).into_owned()
+    }
+
+    /// Reflection of waves arriving from below: `down₂ ← up₂`.
+    pub fn r_below(&self) -> Matrix2<C64> {
+        self.s.fixed_view::<2, 2>(2, 2).into_owned()
+    }
+
+    /// Power ratios (seed eq. S19) of the whole scattering matrix: entry `(i, j)` is the flux
+    /// carried by outgoing wave `i` per unit flux of incoming wave `j`, each wave's own normal
+    /// Poynting flux (`|S_ij|² |P_i| / |P_j|`). Evanescent waves in lossless media carry none.
+    /// Columns of incoming waves that carry no flux are zero.
+    pub fn power(&self) -> Matrix4<f64> {
+        let out = self.outgoing_flux();
+        let inc = self.incoming_flux();
+        Matrix4::from_fn(|i, j| {
+            if inc[j] > 0.0 {
+                self.s[(i, j)].norm_sqr() * out[i] / inc[j]
+            } else {
+                0.0
+            }
+        })
+    }
+
+    /// `|P|` of the outgoing waves `[up₁, down₂]`.
+    pub fn outgoing_flux(&self) -> [f64; 4] {
+        let (u, d) = (&self.upper.up, &self.lower.down);
+        [u[0], u[1], d[0], d[1]].map(|m| m.flux().abs())
+    }
+
+    /// `|P|` of the incoming waves `[down₁, up₂]`.
+    pub fn incoming_flux(&self) -> [f64; 4] {
+        let (d, u) = (&self.upper.down, &self.lower.up);
+        [d[0], d[1], u[0], u[1]].map(|m| m.flux().abs())
+    }
+}
+
+fn singular() -> Error {
+    Error::new(
+        "interface",
+        "the boundary system is singular for this incidence (a guided or degenerate mode)",
+    )
+}

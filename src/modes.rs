@@ -1,0 +1,320 @@
+//! Normal modes of a uniaxial (or isotropic) medium for a given incidence parameter.
+//!
+//! Working frame of this module (the "plane-of-incidence frame"): `z` is the surface normal
+//! pointing into the upper (exterior) medium, `x` is the direction of the tangential wave
+//! vector shared by every wave at the interface, `y = z × x` is the s direction. Every wave has
+//! the wave vector `k = k0 (β, 0, q)`: `β = K/k0` is the incidence parameter (seed eq. S1) and
+//! `q` the normal component (seed eq. S9). Lengths of wave vectors are in units of `k0`, so
+//! nothing here depends on the wavelength (the seed's "note regarding k").
+
+use crate::medium::Uniaxial;
+use nalgebra::Vector3;
+use num_complex::Complex64 as C64;
+
+/// A complex 3-vector.
+pub type C3 = Vector3<C64>;
+
+/// Which polarisation family a mode belongs to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ModeKind {
+    /// Isotropic medium, electric field perpendicular to the plane of incidence.
+    S,
+    /// Isotropic medium, electric field in the plane of incidence: `E = k̂ × ŷ`.
+    P,
+    /// Ordinary wave of a uniaxial medium: `E ⟂ A`.
+    O,
+    /// Extraordinary wave of a uniaxial medium.
+    E,
+}
+
+/// One plane-wave normal mode: `E(r) = e · exp(i k0 (β x + q z))`, `H = k × E` (in units where
+/// the vacuum impedance is 1 and `μ = 1`).
+///
+/// Normalisation: s/p modes of isotropic media use the textbook bilinear basis `E_s = ŷ`,
+/// `E_p = k̂ × ŷ` with `k̂ = k/η` (so Fresnel amplitudes are the textbook ones, for complex `η`
+/// too); o/e modes of anisotropic media have unit Hermitian norm `|E| = 1` with the phase of
+/// the closed-form construction below (real for real wave vectors).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Mode {
+    /// Polarisation family.
+    pub kind: ModeKind,
+    /// Tangential wave-vector component `β = K/k0` (seed eq. S1).
+    pub beta: C64,
+    /// Normal wave-vector component `q/k0` (seed eq. S9).
+    pub q: C64,
+    /// Electric field (seed eq. S10).
+    pub e: C3,
+    /// Magnetic field `k × E` (seed eq. S2).
+    pub h: C3,
+    /// Normal Poynting flux `½ Re(E × H*)_z` of the unit-amplitude mode (positive upwards).
+    pub flux: f64,
+}
+
+impl Mode {
+    fn new(kind: ModeKind, beta: C64, q: C64, e: C3) -> Self {
+        let k = wave_vector(beta, q);
+        let h = k.cross(&e);
+        let flux = 0.5 * (e.x * h.y.conj() - e.y * h.x.conj()).re;
+        Mode {
+            kind,
+            beta,
+            q,
+            e,
+            h,
+            flux,
+        }
+    }
+
+    /// A lossless propagating e-mode whose flux is evaluated without cancellation: its ray is
+    /// `∝ ε k` (seed eq. S12), so `S_z = (S·k) (εk)_z / (kᵀεk)` with `(εk)_z = a q + b = ±w`
+    /// known exactly from the root (near `K_max` the direct `½(E×H*)_z` loses digits).
+    fn lossless_e(beta: C64, q: C64, e: C3, ek_z: f64, kek: f64) -> Self {
+        let mut m = Mode::new(ModeKind::E, beta, q, e);
+        let s = m.poynting();
+        let k = Vector3::new(beta.re, 0.0, q.re);
+        m.flux = s.dot(&k) * ek_z / kek;
+        m
+    }
+
+    /// The wave vector `(β, 0, q)` in units of `k0`.
+    pub fn wave_vector(&self) -> C3 {
+        wave_vector(self.beta, self.q)
+    }
+
+    /// The tangential field components `(E_x, E_y, H_x, H_y)` matched at a boundary (seed eq. S18).
+    pub fn tangential(&self) -> [C64; 4] {
+        [self.e.x, self.e.y, self.h.x, self.h.y]
+    }
+
+    /// Time-averaged Poynting vector `½ Re(E × H*)` of the unit-amplitude mode at the surface.
+    pub fn poynting(&self) -> Vector3<f64> {
+        let hc = self.h.map(|c| c.conj());
+        self.e.cross(&hc).map(|c| 0.5 * c.re)
+    }
+
+    /// Normal component of the Poynting vector: the power this mode carries through the surface
+    /// per unit area (positive upwards).
+    pub fn flux(&self) -> f64 {
+        self.flux
+    }
+
+    /// Unit ray (Poynting) direction (seed eq. S12); `None` if the mode carries no power.
+    pub fn ray_direction(&self) -> Option<Vector3<f64>> {
+        let s = self.poynting();
+        let n = s.norm();
+        (n > 0.0 && n.is_finite()).then(|| s / n)
+    }
+
+    /// Unit wave-normal direction `Re(k)/|Re(k)|` (seed eq. S11).
+    pub fn wave_direction(&self) -> Vector3<f64> {
+        let k = Vector3::new(self.beta.re, 0.0, self.q.re);
+        let n = k.norm();
+        if n > 0.0 {
+            k / n
+        } else {
+            Vector3::z() * self.q.im.signum()
+        }
+    }
+
+    /// Effective index `sqrt(q² + β²)` seen by the wave (seed eq. S13); complex with absorption.
+    pub fn effective_index(&self) -> C64 {
+        (self.q * self.q + self.beta * self.beta).sqrt()
+    }
+
+    /// Ray (phase) index along the Poynting direction, `Re(η_ef) ⟨W, I⟩` (seed eq. S14);
+    /// `None` for a mode that carries no power.
+    pub fn ray_index(&self) -> Option<f64> {
+        let ray = self.ray_direction()?;
+        Some(self.effective_index().re * self.wave_direction().dot(&ray))
+    }
+
+    /// True for a wave that carries (numerically) no power through the surface although its
+    /// field does not vanish: an evanescent wave past `K_max` (seed eq. S15) in a lossless medium.
+    /// (An e-wave past `K_max` keeps a real part of `q`; only its flux tells.)
+    pub fn is_evanescent(&self) -> bool {
+        let scale = self.e.norm() * self.h.norm();
+        self.flux().abs() <= 1e-12 * scale
+    }
+}
+
+/// The four modes of a medium: two travelling/decaying downwards (`-z`), two upwards.
+/// Order within each pair: `[o, e]` for anisotropic media, `[s, p]` for isotropic ones.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ModeSet {
+    /// Modes carrying power (or decaying) towards `-z`.
+    pub down: [Mode; 2],
+    /// Modes carrying power (or decaying) towards `+z`.
+    pub up: [Mode; 2],
+}
+
+/// `(β, 0, q)`.
+pub fn wave_vector(beta: C64, q: C64) -> C3 {
+    Vector3::new(beta, C64::new(0.0, 0.0), q)
+}
+
+/// The normal modes of `medium` (its axis given in the working frame) for incidence parameter
+/// `beta` (seed eqs. S9-S10). Isotropic media get s/p modes.
+pub fn modes(medium: &Uniaxial, beta: C64) -> ModeSet {
+    if medium.is_isotropic() {
+        isotropic_modes(medium.eta_o, beta)
+    } else {
+        uniaxial_modes(medium, beta)
+    }
+}
+
+/// Picks the root pair `(−b ± w)/a` so that the first returned value is the up-going one.
+///
+/// A mode goes up if it decays upwards (`Im q > 0`); for (numerically) lossless propagation,
+/// where `Im` carries no information, if its Poynting flux points up, which for both o and e
+/// waves is the sign of `Re(w/a)` (the e-wave ray is `∝ ε k`, whose normal part is `a q + b`).
+/// For passive media both criteria agree wherever both apply.
+fn up_down(a: C64, b: C64, w: C64) -> (C64, C64) {
+    let (up, down, _) = up_down_w(a, b, w);
+    (up, down)
+}
+
+/// [`up_down`], also returning the `w` of the up-going root (`a q⁺ + b = w`, `a q⁻ + b = −w`).
+fn up_down_w(a: C64, b: C64, w: C64) -> (C64, C64, C64) {
+    let u = w / a;
+    let flip = if u.im.abs() > 1e-9 * u.re.abs() {
+        u.im < 0.0
+    } else {
+        u.re < 0.0
+    };
+    let w = if flip { -w } else { w };
+    ((w - b) / a, (-w - b) / a, w)
+}
+
+/// `η² − β²` evaluated as `(η − β)(η + β)`, exact near grazing/critical incidence.
+fn normal_squared(eta: C64, beta: C64) -> C64 {
+    (eta - beta) * (eta + beta)
+}
+
+/// s and p modes of an isotropic medium of index `eta`.
+pub fn isotropic_modes(eta: C64, beta: C64) -> ModeSet {
+    let one = C64::new(1.0, 0.0);
+    let (q_up, q_down) = up_down(one, C64::new(0.0, 0.0), normal_squared(eta, beta).sqrt());
+    let pair = |q: C64| {
+        let s = Vector3::new(C64::new(0.0, 0.0), one, C64::new(0.0, 0.0));
+        let p = Vector3::new(-q / eta, C64::new(0.0, 0.0), beta / eta);
+        [
+            Mode::new(ModeKind::S, beta, q, s),
+            Mode::new(ModeKind::P, beta, q, p),
+        ]
+    };
+    ModeSet {
+        down: pair(q_down),
+        up: pair(q_up),
+    }
+}
+
+/// Normal components of the extraordinary wave, `(q_e⁺, q_e⁻)` (seed eq. S9).
+///
+/// From `kᵀ ε k = ε_o ε_e` with `k = (β, 0, q)`: `a q² + 2 b q + c = 0`, `a = ε_o + Δε A_z²`,
+/// `b = Δε β A_x A_z`, discriminant `ε_o [ε_e a − β² (ε_e − Δε A_y²)]`.
+pub fn extraordinary_q(medium: &Uniaxial, beta: C64) -> (C64, C64) {
+    let (up, down, _) = extraordinary_q_w(medium, beta);
+    (up, down)
+}
+
+/// [`extraordinary_q`] and the up-going `w = a q⁺ + b`.
+fn extraordinary_q_w(medium: &Uniaxial, beta: C64) -> (C64, C64, C64) {
+    let (eo, ee) = (medium.eps_o(), medium.eps_e());
+    let d = ee - eo;
+    let ax = medium.axis;
+    let a = eo + d * ax.z * ax.z;
+    let b = d * beta * ax.x * ax.z;
+    let disc = eo * (ee * a - beta * beta * (ee - d * ax.y * ax.y));
+    up_down_w(a, b, disc.sqrt())
+}
+
+/// Maximal incidence parameters `(K_o^max, K_e^max)/k0` beyond which the o and e waves are
+/// evanescent (seed eq. S15). For the e-wave: `K² = ε_e (ε_o + Δε A_z²) / (ε_e − Δε A_y²)`, with
+/// `A_z` the normal and `A_y` the s (out-of-plane) component of the axis. (The seed prints the
+/// in-plane tangential component in the denominator; the discriminant of its eq. S9 gives the
+/// out-of-plane one, which is what is implemented and tested.)
+pub fn k_max(medium: &Uniaxial) -> (C64, C64) {
+    let (eo, ee) = (medium.eps_o(), medium.eps_e());
+    let d = ee - eo;
+    let ax = medium.axis;
+    let ke = (ee * (eo + d * ax.z * ax.z) / (ee - d * ax.y * ax.y)).sqrt();
+    (medium.eta_o, ke)
+}
+
+/// o and e modes of a (non-isotropic) uniaxial medium (seed eqs. S9-S10).
+///
+/// Fields are built from the displacement: `D_o ∝ k × A`, `D_e ∝ k × (k × A)` (both ⟂ k),
+/// `E = ε⁻¹ D`. If the wave vector is (numerically) along the axis, `k × A` vanishes, o and e
+/// are degenerate and the o-mode falls back to the s direction `ŷ`; the two fields still span
+/// the transverse plane.
+pub fn uniaxial_modes(medium: &Uniaxial, beta: C64) -> ModeSet {
+    let (qo_up, qo_down) = up_down(
+        C64::new(1.0, 0.0),
+        C64::new(0.0, 0.0),
+        normal_squared(medium.eta_o, beta).sqrt(),
+    );
+    let (qe_up, qe_down, w) = extraordinary_q_w(medium, beta);
+    let exact_flux = medium.is_lossless() && beta.im == 0.0 && w.im == 0.0;
+    let pair = |qo: C64, qe: C64, ek_z: f64| {
+        let e_o = normalize(ordinary_displacement(medium, beta, qo));
+        let ke = wave_vector(beta, qe);
+        let d_e = ke.cross(&ordinary_displacement(medium, beta, qe));
+        let e_e = normalize(medium.inverse_permittivity() * d_e);
+        let e_mode = if exact_flux {
+            let kek = (ke.transpose() * medium.permittivity() * ke)[(0, 0)].re;
+            Mode::lossless_e(beta, qe, e_e, ek_z, kek)
+        } else {
+            Mode::new(ModeKind::E, beta, qe, e_e)
+        };
+        [Mode::new(ModeKind::O, beta, qo, e_o), e_mode]
+    };
+    ModeSet {
+        down: pair(qo_down, qe_down, -w.re),
+        up: pair(qo_up, qe_up, w.re),
+    }
+}
+
+/// `k × A` for `k = (β, 0, q)`, or `ŷ` when `k` is along the axis (degenerate direction).
+fn ordinary_displacement(medium: &Uniaxial, beta: C64, q: C64) -> C3 {
+    let k = wave_vector(beta, q);
+    let a = medium.axis.map(|x| C64::new(x, 0.0));
+    let c = k.cross(&a);
+    let scale = k.iter().map(|z| z.norm()).fold(0.0, f64::max);
+    if c.iter().map(|z| z.norm()).fold(0.0, f64::max) > 1e-12 * scale {
+        c
+    } else {
+        Vector3::new(C64::new(0.0, 0.0), C64::new(1.0, 0.0), C64::new(0.0, 0.0))
+    }
+}
+
+/// `v / |v|` with the Hermitian norm.
+fn normalize(v: C3) -> C3 {
+    let n = v.iter().map(|z| z.norm_sqr()).sum::<f64>().sqrt();
+    v / C64::new(n, 0.0)
+}
+
+/// Wave vector (units of `k0`) of the e-wave whose ray (Poynting) direction is `ray` (unit,
+/// same frame as the axis): the inverse of seed eq. S12 for a lossless uniaxial medium.
+///
+/// The e-wave's ray is the normal of its index surface `kᵀ ε k = ε_o ε_e`, i.e. `∝ ε k`, hence
+/// `k = ε⁻¹ ŝ · sqrt(ε_o ε_e / ŝᵀ ε⁻¹ ŝ)`. Absorption is ignored (real parts of ε are used).
+pub fn extraordinary_wave_vector_from_ray(medium: &Uniaxial, ray: Vector3<f64>) -> Vector3<f64> {
+    let (eo, ee) = (medium.eps_o().re, medium.eps_e().re);
+    let a = medium.axis;
+    let inv = |v: Vector3<f64>| v / eo + a * (a.dot(&v) * (1.0 / ee - 1.0 / eo));
+    let k = inv(ray);
+    k * (eo * ee / ray.dot(&k)).sqrt()
+}
+
+/// Effective index of a wave travelling along the unit wave normal `dir`: `η_o` for the o-wave,
+/// `η(θ) = sqrt(ε_o ε_e / (d̂ᵀ ε d̂))` for the e-wave (seed eq. S13 evaluated from the direction).
+pub fn index_along(medium: &Uniaxial, kind: ModeKind, dir: Vector3<f64>) -> C64 {
+    match kind {
+        ModeKind::E if !medium.is_isotropic() => {
+            let c = medium.axis.dot(&dir);
+            let dtd = medium.eps_o() * (1.0 - c * c) + medium.eps_e() * c * c;
+            (medium.eps_o() * medium.eps_e() / dtd).sqrt()
+        }
+        _ => medium.eta_o,
+    }
+}
