@@ -9,10 +9,13 @@ pub mod calc;
 pub mod crystals;
 pub mod dispersion;
 pub mod error;
+pub mod ffi;
 pub mod frame;
 pub mod interface;
+pub mod lobes;
 pub mod medium;
 pub mod modes;
+pub mod mueller;
 pub mod surface;
 
 pub use error::{Error, Result};

@@ -1,0 +1,113 @@
+//! Jones → Mueller, converted once into Mitsuba's convention.
+//!
+//! The core's fields vary as `exp(−iωt)`; Mitsuba's as `exp(+iωt)` (absorbing index `n − iκ`),
+//! so a core Jones matrix `J` is Mitsuba's `conj(J)`. With Mitsuba's Stokes definitions
+//! (frame `(x, y, k)` right-handed, `S = (|Ex|²+|Ey|², |Ex|²−|Ey|², 2Re(Ex* Ey), 2Im(Ex* Ey))`)
+//! the Mueller matrix is `M = Re(A (J_m ⊗ J_m*) A⁻¹)`, `J_m = conj(J)`,
+//! `A = [[1,0,0,1],[1,0,0,−1],[0,1,1,0],[0,i,−i,0]]`. Written out below entry by entry.
+
+use nalgebra::{Matrix2, Matrix4};
+use num_complex::Complex64 as C64;
+
+/// The Mueller matrix (Mitsuba's convention) of a core Jones matrix `j` (rows = output
+/// components, columns = input components, both in `(x, y)` Stokes frames).
+pub fn from_jones(j: &Matrix2<C64>) -> Matrix4<f64> {
+    let m = j.map(|z| z.conj());
+    let k = m.kronecker(&m.map(|x| x.conj()));
+    (a_matrix() * k * a_inverse()).map(|x| x.re)
+}
+
+/// Mitsuba's coherency → Stokes matrix `A`.
+fn a_matrix() -> Matrix4<C64> {
+    let (o, z, i) = (C64::new(1.0, 0.0), C64::new(0.0, 0.0), C64::new(0.0, 1.0));
+    Matrix4::new(o, z, z, o, o, z, z, -o, z, o, o, z, z, i, -i, z)
+}
+
+/// `A⁻¹ = ½ A†`.
+fn a_inverse() -> Matrix4<C64> {
+    a_matrix().adjoint() * C64::new(0.5, 0.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Stokes vector (Mitsuba's definitions) of a core-convention field `(ex, ey)`.
+    fn stokes(ex: C64, ey: C64) -> [f64; 4] {
+        let (ex, ey) = (ex.conj(), ey.conj()); // Mitsuba's fields
+        let c = ex.conj() * ey;
+        [
+            ex.norm_sqr() + ey.norm_sqr(),
+            ex.norm_sqr() - ey.norm_sqr(),
+            2.0 * c.re,
+            2.0 * c.im,
+        ]
+    }
+
+    #[test]
+    fn mueller_maps_stokes_of_fully_polarised_fields() {
+        let j = Matrix2::new(
+            C64::new(0.3, -0.2),
+            C64::new(-0.1, 0.5),
+            C64::new(0.7, 0.05),
+            C64::new(-0.4, -0.6),
+        );
+        let m = from_jones(&j);
+        for (ex, ey) in [(1.0, 0.0), (0.3, 0.8), (-0.5, 0.2)] {
+            let e = (C64::new(ex, 0.1), C64::new(ey, -0.4));
+            let out = (
+                j[(0, 0)] * e.0 + j[(0, 1)] * e.1,
+                j[(1, 0)] * e.0 + j[(1, 1)] * e.1,
+            );
+            let (si, so) = (stokes(e.0, e.1), stokes(out.0, out.1));
+            for r in 0..4 {
+                let got: f64 = (0..4).map(|c| m[(r, c)] * si[c]).sum();
+                assert!((got - so[r]).abs() < 1e-14, "row {r}: {got} vs {}", so[r]);
+            }
+        }
+    }
+
+    #[test]
+    fn retarder_matches_mitsuba_linear_retarder() {
+        // Core convention: a wave through index n gains exp(+i k n d); y slower by phi.
+        let phi = 0.7f64;
+        let j = Matrix2::new(
+            C64::new(1.0, 0.0),
+            C64::new(0.0, 0.0),
+            C64::new(0.0, 0.0),
+            C64::from_polar(1.0, phi),
+        );
+        let m = from_jones(&j);
+        // mueller::linear_retarder(phi) of Mitsuba 3.
+        let want = Matrix4::new(
+            1.0,
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+            1.0,
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+            phi.cos(),
+            phi.sin(),
+            0.0,
+            0.0,
+            -phi.sin(),
+            phi.cos(),
+        );
+        assert!((m - want).norm() < 1e-15, "{m}");
+    }
+
+    #[test]
+    fn polarizer_along_x() {
+        let o = C64::new(1.0, 0.0);
+        let z = C64::new(0.0, 0.0);
+        let m = from_jones(&Matrix2::new(o, z, z, z));
+        let want = Matrix4::new(
+            0.5, 0.5, 0.0, 0.0, 0.5, 0.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
+        );
+        assert!((m - want).norm() < 1e-15);
+    }
+}
