@@ -16,6 +16,8 @@ pub mod lobes;
 pub mod medium;
 pub mod modes;
 pub mod mueller;
+pub mod paths;
+pub mod slab;
 pub mod surface;
 
 pub use error::{Error, Result};

@@ -12,8 +12,24 @@ use num_complex::Complex64 as C64;
 /// The Mueller matrix (Mitsuba's convention) of a core Jones matrix `j` (rows = output
 /// components, columns = input components, both in `(x, y)` Stokes frames).
 pub fn from_jones(j: &Matrix2<C64>) -> Matrix4<f64> {
-    let m = j.map(|z| z.conj());
-    let k = m.kronecker(&m.map(|x| x.conj()));
+    from_coherency(&coherency(j))
+}
+
+/// The coherency superoperator `K(J) = J_m ⊗ conj(J_m) = conj(J) ⊗ J`: it maps the vectorised
+/// coherency matrix (Mitsuba's convention) of the input to that of the output, and composes
+/// like the Jones matrices do (`K(J₁J₂) = K(J₁)K(J₂)`). Sums of `K` over incoherent paths and
+/// band-integrated sums over coherent pairs of paths are still coherency superoperators.
+pub fn coherency(j: &Matrix2<C64>) -> Matrix4<C64> {
+    j.map(|z| z.conj()).kronecker(j)
+}
+
+/// The cross term `conj(J₁) ⊗ J₂` of two coherent contributions (`coherency(J) = cross(J, J)`).
+pub fn cross(j1: &Matrix2<C64>, j2: &Matrix2<C64>) -> Matrix4<C64> {
+    j1.map(|z| z.conj()).kronecker(j2)
+}
+
+/// The Mueller matrix `Re(A K A⁻¹)` of a coherency superoperator.
+pub fn from_coherency(k: &Matrix4<C64>) -> Matrix4<f64> {
     (a_matrix() * k * a_inverse()).map(|x| x.re)
 }
 

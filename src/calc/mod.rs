@@ -4,17 +4,19 @@ pub mod input;
 pub mod interface;
 pub mod media;
 pub mod output;
+pub mod slab;
 
 use crate::error::{Error, Result};
 use serde_json::{json, Value};
 
 /// The subcommands.
-pub const SUBCOMMANDS: [&str; 1] = ["interface"];
+pub const SUBCOMMANDS: [&str; 2] = ["interface", "slab"];
 
 /// Runs `subcommand` on one input object; errors become `{"error": "..."}` at the caller.
 pub fn run(subcommand: &str, input: &Value) -> Result<Value> {
     match subcommand {
         "interface" => interface::run(input),
+        "slab" => slab::run(input),
         _ => Err(Error::new(
             "subcommand",
             format!(

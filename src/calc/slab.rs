@@ -1,0 +1,96 @@
+//! `birefringence slab`: a plane-parallel uniaxial plate.
+
+use super::input::Fields;
+use super::interface::read_incidence;
+use super::media;
+use super::output::{complex, num};
+use crate::error::{Error, Result};
+use crate::slab::{Slab, Want};
+use crate::surface::Surface;
+use nalgebra::{Matrix2, Matrix4};
+use num_complex::Complex64 as C64;
+use serde_json::{json, Map, Value};
+
+/// A parsed slab query.
+pub struct SlabQuery {
+    /// The slab.
+    pub slab: Slab,
+    /// Vacuum wavelength (nm).
+    pub wavelength_nm: f64,
+    /// Plane of incidence.
+    pub frame: crate::frame::PlaneFrame,
+    /// Incidence parameter.
+    pub beta: C64,
+}
+
+/// Reads the slab fields (everything but `spectrum`).
+pub fn read(f: &mut Fields) -> Result<SlabQuery> {
+    let m = media::read(f)?;
+    let thickness_um = f.required_number("thickness_um")?;
+    if thickness_um < 0.0 {
+        return Err(Error::new(
+            "thickness_um",
+            format!("must be >= 0, got {thickness_um}"),
+        ));
+    }
+    let exit = media::read_ior(f, "exit_ior", m.wavelength_nm)?.unwrap_or(m.ext);
+    let surface = Surface::new(m.ext, m.crystal)?;
+    let inc = read_incidence(f, &surface, false)?;
+    Ok(SlabQuery {
+        slab: Slab::new(m.ext, m.crystal, exit, thickness_um * 1e3)?,
+        wavelength_nm: m.wavelength_nm,
+        frame: inc.frame,
+        beta: inc.beta,
+    })
+}
+
+/// Runs the `slab` subcommand on one input object.
+pub fn run(input: &Value) -> Result<Value> {
+    let mut f = Fields::new(input)?;
+    let q = read(&mut f)?;
+    f.finish()?;
+    let optics = q.slab.optics(&q.frame, q.beta)?;
+    let j = optics.jones(q.wavelength_nm, Want::BOTH)?;
+    let (r, t) = (j.r.unwrap_or_default(), j.t.unwrap_or_default());
+    let mut out = Map::new();
+    out.insert("R".into(), powers(&r));
+    out.insert("T".into(), powers(&t));
+    out.insert("jones".into(), json!({"R": jones(&r), "T": jones(&t)}));
+    let (mr, mt) = (
+        crate::mueller::from_jones(&r),
+        crate::mueller::from_jones(&t),
+    );
+    out.insert(
+        "mueller".into(),
+        json!({"R": matrix(&mr), "T": matrix(&mt)}),
+    );
+    out.insert("beta".into(), complex(q.beta));
+    Ok(Value::Object(out))
+}
+
+const SP: [&str; 2] = ["s", "p"];
+
+/// `{"ss", "sp", "ps", "pp"}`: input polarisation first, output second.
+pub fn powers(j: &Matrix2<C64>) -> Value {
+    let mut m = Map::new();
+    for (a, ia) in SP.iter().enumerate() {
+        for (b, ob) in SP.iter().enumerate() {
+            m.insert(format!("{ia}{ob}"), num(j[(b, a)].norm_sqr()));
+        }
+    }
+    Value::Object(m)
+}
+
+/// Rows = output (s, p), columns = input (s, p), entries `[re, im]`.
+fn jones(j: &Matrix2<C64>) -> Value {
+    json!((0..2)
+        .map(|r| (0..2).map(|c| complex(j[(r, c)])).collect::<Vec<_>>())
+        .collect::<Vec<_>>())
+}
+
+/// Row-major 4x4.
+pub fn matrix(m: &Matrix4<f64>) -> Value {
+    json!((0..4)
+        .map(|r| (0..4).map(|c| num(m[(r, c)])).collect::<Vec<_>>())
+        .collect::<Vec<_>>())
+}
