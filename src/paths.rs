@@ -161,7 +161,7 @@ impl IncoherentTail {
         let pd = prop([att(m.down[0].q, -1.0), att(m.down[1].q, -1.0)]);
         let pu = prop([att(m.up[0].q, 1.0), att(m.up[1].q, 1.0)]);
         let k = mueller::coherency;
-        let x0 = pd * state.iter().map(|(_, a)| k(a)).sum::<Matrix4<C64>>();
+        let x0 = pd * state.values().map(k).sum::<Matrix4<C64>>();
         let (r2, r3) = (optics.bottom.r_above(), optics.top.r_below());
         let after_bottom = pu * k(&r2);
         let rt = pd * k(&r3) * after_bottom;
