@@ -93,6 +93,20 @@ impl Uniaxial {
     }
 }
 
+/// Validates the index of an isotropic medium that light arrives from or leaves into: real and
+/// `> 0`. (With absorption there the incident plane wave is inhomogeneous and power fractions
+/// are undefined.)
+pub fn check_clear_index(parameter: &str, eta: C64) -> Result<C64> {
+    check_index(parameter, eta)?;
+    if eta.im != 0.0 {
+        return Err(Error::new(
+            parameter,
+            "must be real: absorbing exterior or exit media are not supported (the incident wave would be inhomogeneous and power fractions undefined)",
+        ));
+    }
+    Ok(eta)
+}
+
 /// Validates one complex index `n + iκ`: finite, `n > 0`, `κ >= 0`.
 pub fn check_index(parameter: &str, eta: C64) -> Result<C64> {
     if !eta.re.is_finite() || !eta.im.is_finite() {

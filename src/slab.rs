@@ -17,7 +17,7 @@
 use crate::error::{Error, Result};
 use crate::frame::PlaneFrame;
 use crate::interface::Interface;
-use crate::medium::{check_index, Uniaxial};
+use crate::medium::{check_clear_index, Uniaxial};
 use crate::modes::{modes, ModeSet};
 use crate::mueller;
 use nalgebra::{Matrix2, Matrix4};
@@ -96,11 +96,19 @@ impl Slab {
             ));
         }
         Ok(Slab {
-            top: Uniaxial::isotropic(check_index("ext_ior", top)?)?,
+            top: Uniaxial::isotropic(check_clear_index("ext_ior", top)?)?,
             layer,
-            bottom: Uniaxial::isotropic(check_index("exit_ior", bottom)?)?,
+            bottom: Uniaxial::isotropic(check_clear_index("exit_ior", bottom)?)?,
             thickness_nm,
         })
+    }
+
+    /// The layer's modes for incidence parameter `beta` in the plane of `frame`.
+    pub fn layer_modes(&self, frame: &PlaneFrame, beta: C64) -> ModeSet {
+        modes(
+            &self.layer.with_axis(frame.to_working(self.layer.axis)),
+            beta,
+        )
     }
 
     /// Solves both interfaces for incidence parameter `beta` in the plane of `frame`.

@@ -8,7 +8,7 @@
 use crate::error::{Error, Result};
 use crate::frame::PlaneFrame;
 use crate::interface::Interface;
-use crate::medium::{check_index, Uniaxial};
+use crate::medium::{check_clear_index, Uniaxial};
 use crate::modes::{index_along, k_max, Mode, ModeKind};
 use nalgebra::Vector3;
 use num_complex::Complex64 as C64;
@@ -43,7 +43,7 @@ pub struct Solved {
 impl Surface {
     /// A surface between an isotropic exterior of index `ext` and `crystal`.
     pub fn new(ext: C64, crystal: Uniaxial) -> Result<Self> {
-        let exterior = Uniaxial::isotropic(check_index("ext_ior", ext)?)?;
+        let exterior = Uniaxial::isotropic(check_clear_index("ext_ior", ext)?)?;
         Ok(Surface { exterior, crystal })
     }
 

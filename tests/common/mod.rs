@@ -1,0 +1,55 @@
+//! Shared helpers of the integration tests: a seeded RNG and the independent Berreman 4x4
+//! reference ([`berreman`]).
+#![allow(dead_code)]
+
+pub mod berreman;
+
+use nalgebra::Vector3;
+
+/// SplitMix64: a tiny, seeded, reproducible generator (no external crates).
+#[derive(Clone, Debug)]
+pub struct Rng(u64);
+
+impl Rng {
+    /// A generator from a seed.
+    pub fn new(seed: u64) -> Self {
+        Rng(seed)
+    }
+
+    /// The next 64 random bits.
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in `[0, 1)`.
+    pub fn uniform(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    }
+
+    /// Uniform in `[a, b)`.
+    pub fn range(&mut self, a: f64, b: f64) -> f64 {
+        a + (b - a) * self.uniform()
+    }
+
+    /// True with probability `p`.
+    pub fn chance(&mut self, p: f64) -> bool {
+        self.uniform() < p
+    }
+
+    /// Uniform index in `0..n`.
+    pub fn index(&mut self, n: usize) -> usize {
+        ((self.uniform() * n as f64) as usize).min(n - 1)
+    }
+
+    /// A unit vector uniformly distributed on the sphere.
+    pub fn unit_vector(&mut self) -> Vector3<f64> {
+        let z = self.range(-1.0, 1.0);
+        let phi = self.range(0.0, 2.0 * std::f64::consts::PI);
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        Vector3::new(r * phi.cos(), r * phi.sin(), z)
+    }
+}
