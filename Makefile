@@ -3,14 +3,16 @@
 #   make render   the main job: builds everything (make setup), then makes out/fig1.png
 #                 and out/fig1.json (Figure 1 of the paper's supplemental)
 #   make test     builds everything (make setup), then runs every test: cargo's, then pytest's
-#   make setup    cargo build --release + the virtualenv .venv/ from requirements.txt;
+#   make setup    cargo build --release, the virtualenv .venv/ from requirements.txt, the
+#                 Mitsuba plugin library (cpp/) and the mitsuba_birefringent package in .venv/;
 #                 idempotent, and quick when nothing changed
+#   make plugin   (part of setup) the plugin library plugin/mitsuba_birefringent/*.so and the .pth
 #   make fmt      cargo fmt --check
 #   make lint     cargo clippy on all targets, warnings are errors
 #   make clean    removes build outputs (target/, out/, Python caches); keeps .venv/
 #   make distclean  clean, and removes .venv/ too
-#
-# There is no `bench` target yet: it will be added together with the first benchmarks.
+#   make bench    make setup, then the core benchmark on one core (taskset -c 0) and its plot:
+#                 bench/out/core.json, bench/out/core_error_vs_time.png (several minutes)
 
 SHELL := bash
 .SHELLFLAGS := -euo pipefail -c
@@ -30,14 +32,37 @@ PYTESTS := tests/python
 
 PIP_FLAGS := --disable-pip-version-check --no-input --progress-bar off
 
-.PHONY: help setup build venv render test test-rust test-python fmt lint clean distclean
+# The Mitsuba plugin library: the C++ shim (cpp/src/*.cpp) + the Rust core's static library,
+# compiled against the headers of the mitsuba/drjit/nanobind wheels in .venv/, written into the
+# Python package plugin/mitsuba_birefringent/ (which .venv/ imports through a .pth file).
+RUST_LIB := target/release/libbirefringent.a
+CPP_OBJ_DIR := target/cpp
+CPP_SRCS := $(wildcard cpp/src/*.cpp)
+CPP_OBJS := $(patsubst cpp/src/%.cpp,$(CPP_OBJ_DIR)/%.o,$(CPP_SRCS))
+CPP_HDRS := $(wildcard cpp/src/*.h) cpp/include/birefringent.h
+PLUGIN_SO := plugin/mitsuba_birefringent/libmitsuba_birefringent.so
+# site-packages of .venv/ (evaluated when used: the venv may not exist yet when make starts)
+SITE = $(shell $(VPY) -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')
+# These flags must match the PyPI wheels (see the notes on building against Mitsuba): above all
+# -march=ivybridge, which sets Dr.Jit's array padding and so the layout of Mitsuba's structs.
+MI_CXXFLAGS = -std=c++17 -O2 -fPIC -fvisibility=hidden -march=ivybridge -ffp-contract=fast \
+  -fno-math-errno -DNDEBUG -DMI_ENABLE_LLVM=1 -DMI_ENABLE_CUDA=1 -DMI_ENABLE_EMBREE=1 \
+  -DMI_ENABLE_AUTODIFF=1 -Wall -Icpp/include -isystem $(SITE)/mitsuba/include \
+  -isystem $(SITE)/drjit/include -isystem $(SITE)/nanobind/include \
+  -isystem $(SITE)/nanobind/ext/robin_map/include
+MI_LDFLAGS = -shared -L$(SITE)/mitsuba -lmitsuba -L$(SITE)/drjit -ldrjit-core \
+  -Wl,-rpath,$(SITE)/mitsuba -Wl,-rpath,$(SITE)/drjit \
+  -Wl,--exclude-libs,ALL -Wl,--gc-sections -Wl,--strip-debug -Wl,--no-undefined \
+  -lpthread -ldl -lm
+
+.PHONY: help setup build venv plugin render test test-rust test-python bench fmt lint clean distclean
 
 help:
-	@sed -n '3,13s/^# \{0,1\}//p' $(firstword $(MAKEFILE_LIST))
+	@sed -n '3,/^$$/s/^# \{0,1\}//p' $(firstword $(MAKEFILE_LIST))
 
 ## ---- set-up -------------------------------------------------------------------------------
 
-setup: build venv
+setup: build venv plugin
 
 # Always asks cargo: it tracks the Rust sources itself and returns in well under a second when
 # target/ is up to date. Builds the library and the `birefringence` calculator binary.
@@ -58,6 +83,26 @@ $(VENV_STAMP): requirements.txt
 	$(VPY) -m pip install $(PIP_FLAGS) -r requirements.txt
 	@touch $@
 
+# The plugin library and the package: `import mitsuba; import mitsuba_birefringent` in .venv/
+# registers the BSDFs `thinbirefringent` and `birefringent`. The package is installed as a .pth
+# file pointing at plugin/ (no build step, no network; rewritten if the checkout moves).
+plugin: build venv
+	@$(MAKE) --no-print-directory $(PLUGIN_SO)
+	@pth="$(SITE)/mitsuba_birefringent.pth"; \
+	if [ "$$(cat "$$pth" 2>/dev/null)" != "$(CURDIR)/plugin" ]; then \
+	  echo "$(CURDIR)/plugin" > "$$pth"; echo "installed mitsuba_birefringent into $(VENV)/ ($$pth)"; \
+	fi
+
+$(CPP_OBJ_DIR)/%.o: cpp/src/%.cpp $(CPP_HDRS) $(VENV_STAMP)
+	@mkdir -p $(@D)
+	$(CXX) $(MI_CXXFLAGS) -c $< -o $@
+
+$(PLUGIN_SO): $(CPP_OBJS) $(RUST_LIB)
+	$(CXX) -o $@ $(CPP_OBJS) $(RUST_LIB) $(MI_LDFLAGS)
+
+$(RUST_LIB):
+	$(CARGO) build --release --lib
+
 ## ---- main job ---------------------------------------------------------------------------
 
 # Figure 1 of the supplemental: Fresnel power ratios of an isotropic/uniaxial interface,
@@ -77,12 +122,29 @@ test-rust:
 
 # pytest exits 5 when it collects no test: that is accepted only if tests/python really holds
 # no test file; any other non-zero exit (or 5 with test files present) is a failure.
-test-python: venv
+test-python: plugin
 	@rc=0; $(VPY) -m pytest -q $(PYTESTS) || rc=$$?; \
 	if [ $$rc -eq 5 ] && [ -z "$$(find $(PYTESTS) -name 'test_*.py' -o -name '*_test.py' 2>/dev/null)" ]; then \
 	  echo "$(PYTESTS): no Python test files; nothing to run"; rc=0; \
 	fi; \
 	exit $$rc
+
+## ---- benchmark ------------------------------------------------------------------------
+
+# examples/bench_core.rs: timings of the exact optics and of the closed-form spectral integration,
+# the validation run of tests/spectral_rgb.rs on BENCH_PLATES random plates, and error vs time
+# against stochastic wavelength sampling; then bench/plot_core.py. Built by cargo (unpinned),
+# run pinned to one core when taskset exists. Results: bench/out/core.json and the plot.
+BENCH_OUT := bench/out
+BENCH_PLATES ?= 500
+BENCH_BIN := target/release/examples/bench_core
+TASKSET := $(shell command -v taskset >/dev/null 2>&1 && echo taskset -c 0)
+
+bench: setup
+	$(CARGO) build --release --example bench_core
+	@mkdir -p $(BENCH_OUT)
+	$(TASKSET) $(BENCH_BIN) --validate $(BENCH_PLATES) --out $(BENCH_OUT)/core.json
+	$(VPY) bench/plot_core.py $(BENCH_OUT)/core.json $(BENCH_OUT)/core_error_vs_time.png
 
 ## ---- code quality ----------------------------------------------------------------------
 
@@ -96,6 +158,7 @@ lint:
 
 clean:
 	$(CARGO) clean
+	rm -f $(PLUGIN_SO)
 	rm -rf $(OUT) .pytest_cache
 	find . -path ./$(VENV) -prune -o -type d -name __pycache__ -prune -exec rm -rf {} +
 

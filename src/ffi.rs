@@ -1,25 +1,41 @@
 //! The C ABI of the static library, for the C++ shim. Declared in `cpp/include/birefringent.h`
 //! (kept by hand; `tests/c_abi.rs` compiles and runs a C program against it).
 //!
-//! Rules: plain `#[repr(C)]` structs, every function returns a status code and never unwinds
-//! (panics are caught), invalid input gives `BFR_INVALID` and a message naming the parameter.
+//! Rules: plain `#[repr(C)]` structs and one opaque handle; every function returns a status
+//! code and never unwinds (panics are caught); invalid input gives `BFR_INVALID` and a message
+//! naming the parameter; a non-finite result is reported as `BFR_INTERNAL`, never returned.
 
-use crate::lobes::{scatter, Lobe};
+use crate::error::{Error, Result};
+use crate::material::Material;
 use crate::medium::Uniaxial;
-use crate::modes::ModeKind;
-use crate::surface::{Incident, Surface};
-use crate::{Error, C64};
+use crate::sampling::{crystal_lobes, plate_lobes, PathLobe, PlateQuery, Spectrum, Transport};
+use crate::spectral::weights::WeightSet;
+use crate::surface::Surface;
+use crate::C64;
 use nalgebra::Vector3;
+use std::ffi::CStr;
 use std::os::raw::c_char;
 
 /// Success.
 pub const BFR_OK: i32 = 0;
-/// Invalid input; the message says which parameter.
+/// Invalid input; the message names the parameter.
 pub const BFR_INVALID: i32 = 1;
-/// A bug (a caught panic or a non-finite result); the message says so.
+/// A bug (a caught panic or a non-finite result).
 pub const BFR_INTERNAL: i32 = 2;
+/// Plate flag: compute reflection.
+pub const BFR_WANT_REFLECTION: i32 = 1;
+/// Plate flag: compute transmission.
+pub const BFR_WANT_TRANSMISSION: i32 = 2;
+/// Plate flag: intensity only.
+pub const BFR_INTENSITY_ONLY: i32 = 4;
+/// Mitsuba's `TransportMode::Radiance`.
+pub const BFR_RADIANCE: i32 = 0;
+/// Mitsuba's `TransportMode::Importance`.
+pub const BFR_IMPORTANCE: i32 = 1;
+/// Lobes of a bulk crystal query.
+pub const BFR_CRYSTAL_LOBES: usize = 6;
 
-/// A complex number `re + i im` (core convention: absorbing indices have `im >= 0`).
+/// `re + i im`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default)]
 pub struct BfrComplex {
@@ -27,73 +43,74 @@ pub struct BfrComplex {
     pub im: f64,
 }
 
-/// A crystal surface under an isotropic exterior, at one wavelength.
+/// Principal indices of a material.
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Default)]
-pub struct BfrSurface {
-    pub ext_ior: BfrComplex,
+#[derive(Clone, Copy, Debug)]
+pub struct BfrMaterialDesc {
+    pub material: *const c_char,
     pub eta_o: BfrComplex,
     pub eta_e: BfrComplex,
-    /// Optic axis in the local shading frame (any non-zero length).
+    pub kappa_o: f64,
+    pub kappa_e: f64,
+}
+
+/// Opaque material handle.
+pub struct BfrMaterial(Material);
+
+/// Per-query geometry.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct BfrGeometry {
+    pub ext_ior: f64,
+    pub exit_ior: f64,
     pub optic_axis: [f64; 3],
+    pub thickness_nm: f64,
+    pub birefringence: f64,
 }
 
-/// One outgoing wave (see `crate::lobes`).
+/// One lobe as a path tracer samples it.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default)]
-pub struct BfrLobe {
-    /// 1 if the wave exists and carries power away from the surface, else 0.
+pub struct BfrPathLobe {
     pub exists: i32,
-    /// 0: exterior (or isotropic-crystal) s/p wave, 2: o-wave, 3: e-wave.
-    pub kind: i32,
-    /// Unit ray direction, local frame, pointing away from the surface.
-    pub direction: [f64; 3],
-    /// `x` axis of its Stokes frame (`y = direction × x`).
-    pub stokes_x: [f64; 3],
-    /// Mueller matrix, row-major, Mitsuba's convention: incident Stokes (frame
-    /// `BfrEvent::incident_stokes_x`) → this wave's Stokes, power fractions.
+    pub component: i32,
+    pub wo: [f64; 3],
+    pub in_stokes_x: [f64; 3],
+    pub out_stokes_x: [f64; 3],
     pub mueller: [f64; 16],
+    pub weight: f64,
+    pub eta: f64,
 }
 
-/// All lobes of a surface event.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default)]
-pub struct BfrEvent {
-    /// `x` axis of the incident wave's Stokes frame (its propagation is `−towards_light`).
-    pub incident_stokes_x: [f64; 3],
-    /// Outside incidence: `[exterior, none]`; inside: `[o, e]`.
-    pub reflected: [BfrLobe; 2],
-    /// Outside incidence: `[o, e]`; inside: `[exterior, none]`.
-    pub transmitted: [BfrLobe; 2],
-}
-
-fn complex(c: BfrComplex) -> C64 {
+fn c64(c: BfrComplex) -> C64 {
     C64::new(c.re, c.im)
-}
-
-fn v3(v: &[f64; 3]) -> Vector3<f64> {
-    Vector3::new(v[0], v[1], v[2])
 }
 
 fn a3(v: Vector3<f64>) -> [f64; 3] {
     [v.x, v.y, v.z]
 }
 
-fn lobe(l: &Option<Lobe>) -> BfrLobe {
-    match l {
-        None => BfrLobe::default(),
-        Some(l) => BfrLobe {
-            exists: 1,
-            kind: match l.kind {
-                ModeKind::O => 2,
-                ModeKind::E => 3,
-                _ => 0,
-            },
-            direction: a3(l.direction),
-            stokes_x: a3(l.stokes_x),
-            mueller: std::array::from_fn(|k| l.mueller[(k / 4, k % 4)]),
-        },
+fn lobe(l: &PathLobe) -> BfrPathLobe {
+    BfrPathLobe {
+        exists: 1,
+        component: l.component as i32,
+        wo: a3(l.wo),
+        in_stokes_x: a3(l.in_stokes_x),
+        out_stokes_x: a3(l.out_stokes_x),
+        mueller: std::array::from_fn(|k| l.mueller[(k / 4, k % 4)]),
+        weight: l.weight,
+        eta: l.eta,
     }
+}
+
+/// True if every number of a lobe is finite.
+fn finite(l: &BfrPathLobe) -> bool {
+    l.wo.iter()
+        .chain(&l.in_stokes_x)
+        .chain(&l.out_stokes_x)
+        .chain(&l.mueller)
+        .chain([&l.weight, &l.eta])
+        .all(|x| x.is_finite())
 }
 
 /// Writes `msg` into the caller's buffer (NUL-terminated, truncated to fit).
@@ -110,84 +127,286 @@ unsafe fn write_message(msg: &str, buf: *mut c_char, len: usize) {
     }
 }
 
-fn event(surface: &BfrSurface, towards_light: &[f64; 3], incident: i32) -> Result<BfrEvent, Error> {
-    let crystal = Uniaxial::new(
-        complex(surface.eta_o),
-        complex(surface.eta_e),
-        v3(&surface.optic_axis),
-    )?;
-    let s = Surface::new(complex(surface.ext_ior), crystal)?;
-    let incident = match incident {
-        0 => Incident::Outside,
-        1 => Incident::Inside(ModeKind::O),
-        2 => Incident::Inside(ModeKind::E),
-        _ => {
-            return Err(Error::new(
-                "incident",
-                "must be 0 (outside), 1 (o inside) or 2 (e inside)",
-            ))
-        }
-    };
-    let e = scatter(&s, v3(towards_light), incident)?;
-    let out = BfrEvent {
-        incident_stokes_x: a3(e.incident_stokes_x),
-        reflected: [lobe(&e.reflected[0]), lobe(&e.reflected[1])],
-        transmitted: [lobe(&e.transmitted[0]), lobe(&e.transmitted[1])],
-    };
-    let finite = out.reflected.iter().chain(out.transmitted.iter()).all(|l| {
-        l.mueller
-            .iter()
-            .chain(l.direction.iter())
-            .all(|x| x.is_finite())
-    });
-    if finite {
-        Ok(out)
-    } else {
-        Err(Error::new(
-            "internal",
-            "non-finite result (a bug: please report the input)",
-        ))
-    }
-}
-
-/// Scatters light arriving at a crystal surface from `towards_light` (unit, local frame).
-/// `incident`: 0 = from the exterior (`z > 0`), 1 = an o-wave from inside, 2 = an e-wave from
-/// inside (`z < 0`; for inside waves `towards_light` is minus the ray direction).
-/// Returns `BFR_OK` and fills `out`, or an error code and a message in `message`.
-///
-/// # Safety
-/// `surface`, `towards_light` (3 doubles) and `out` must be valid pointers; `message` must be
-/// null or point to `message_len` writable bytes.
-#[no_mangle]
-pub unsafe extern "C" fn bfr_surface_scatter(
-    surface: *const BfrSurface,
-    towards_light: *const f64,
-    incident: i32,
-    out: *mut BfrEvent,
-    message: *mut c_char,
-    message_len: usize,
-) -> i32 {
-    if surface.is_null() || towards_light.is_null() || out.is_null() {
-        // SAFETY: message validity is the caller's contract.
-        unsafe { write_message("null pointer argument", message, message_len) };
-        return BFR_INVALID;
-    }
-    // SAFETY: non-null pointers to valid memory by the caller's contract.
-    let (s, w) = unsafe { (*surface, *(towards_light as *const [f64; 3])) };
-    let result = std::panic::catch_unwind(|| event(&s, &w, incident));
-    let (code, msg) = match result {
-        Ok(Ok(e)) => {
-            // SAFETY: `out` is valid by the caller's contract.
-            unsafe { *out = e };
-            return BFR_OK;
-        }
+/// Runs `f` with panics caught, mapping the outcome to a status code and a message.
+unsafe fn guarded(message: *mut c_char, len: usize, f: impl FnOnce() -> Result<()>) -> i32 {
+    let (code, msg) = match std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)) {
+        Ok(Ok(())) => return BFR_OK,
         Ok(Err(e)) if e.parameter == "internal" => (BFR_INTERNAL, e.to_string()),
         Ok(Err(e)) => (BFR_INVALID, e.to_string()),
         Err(_) => (BFR_INTERNAL, "internal error (panic caught)".to_string()),
     };
-    // SAFETY: as above.
-    unsafe { write_message(&msg, message, message_len) };
+    // SAFETY: message validity is the caller's contract.
+    unsafe { write_message(&msg, message, len) };
     code
+}
+
+fn null(name: &str) -> Error {
+    Error::new(name, "null pointer")
+}
+
+fn material_from(desc: &BfrMaterialDesc) -> Result<Material> {
+    if desc.material.is_null() {
+        for (name, k) in [("kappa_o", desc.kappa_o), ("kappa_e", desc.kappa_e)] {
+            if !(k.is_finite() && k >= 0.0) {
+                return Err(Error::new(
+                    name,
+                    format!("must be finite and >= 0, got {k}"),
+                ));
+            }
+        }
+        let eo = c64(desc.eta_o) + C64::new(0.0, desc.kappa_o);
+        let ee = c64(desc.eta_e) + C64::new(0.0, desc.kappa_e);
+        return Material::constant(eo, ee);
+    }
+    // SAFETY: a non-null `material` is a NUL-terminated string by the caller's contract.
+    let name = unsafe { CStr::from_ptr(desc.material) }
+        .to_str()
+        .map_err(|_| Error::new("material", "is not valid UTF-8"))?;
+    Material::named(name, desc.kappa_o, desc.kappa_e)
+}
+
+/// Creates a material handle, or returns null and writes a message.
+///
+/// # Safety
+/// `desc` must be null or valid; `message` null or `message_len` writable bytes.
+#[no_mangle]
+pub unsafe extern "C" fn bfr_material_new(
+    desc: *const BfrMaterialDesc,
+    message: *mut c_char,
+    message_len: usize,
+) -> *mut BfrMaterial {
+    let mut out = std::ptr::null_mut();
+    // SAFETY: pointer contracts above.
+    unsafe {
+        guarded(message, message_len, || {
+            let d = desc.as_ref().ok_or_else(|| null("desc"))?;
+            out = Box::into_raw(Box::new(BfrMaterial(material_from(d)?)));
+            Ok(())
+        })
+    };
+    out
+}
+
+/// Frees a material handle (null is ignored).
+///
+/// # Safety
+/// `m` must come from `bfr_material_new` and not be used afterwards.
+#[no_mangle]
+pub unsafe extern "C" fn bfr_material_free(m: *mut BfrMaterial) {
+    if !m.is_null() {
+        // SAFETY: created by Box::into_raw in bfr_material_new.
+        drop(unsafe { Box::from_raw(m) });
+    }
+}
+
+/// Indices at a wavelength.
+///
+/// # Safety
+/// Valid pointers (outputs writable).
+#[no_mangle]
+pub unsafe extern "C" fn bfr_material_indices(
+    m: *const BfrMaterial,
+    wavelength_nm: f64,
+    eta_o: *mut BfrComplex,
+    eta_e: *mut BfrComplex,
+) -> i32 {
+    // SAFETY: pointer contracts above.
+    unsafe {
+        guarded(std::ptr::null_mut(), 0, || {
+            let m = m.as_ref().ok_or_else(|| null("material"))?;
+            let (o, e) = m.0.indices(wavelength_nm, 0.0)?;
+            let (po, pe) = (
+                eta_o.as_mut().ok_or_else(|| null("eta_o"))?,
+                eta_e.as_mut().ok_or_else(|| null("eta_e"))?,
+            );
+            *po = BfrComplex { re: o.re, im: o.im };
+            *pe = BfrComplex { re: e.re, im: e.im };
+            Ok(())
+        })
+    }
+}
+
+fn vec3(p: *const f64, name: &str) -> Result<Vector3<f64>> {
+    if p.is_null() {
+        return Err(null(name));
+    }
+    // SAFETY: non-null pointer to 3 doubles by the caller's contract.
+    let a = unsafe { std::slice::from_raw_parts(p, 3) };
+    Ok(Vector3::new(a[0], a[1], a[2]))
+}
+
+fn transport(t: i32) -> Result<Transport> {
+    match t {
+        BFR_RADIANCE => Ok(Transport::Radiance),
+        BFR_IMPORTANCE => Ok(Transport::Importance),
+        _ => Err(Error::new(
+            "transport",
+            "must be BFR_RADIANCE (0) or BFR_IMPORTANCE (1)",
+        )),
+    }
+}
+
+/// Copies lobes into `out[..n]` (unused entries zeroed), refusing non-finite numbers.
+fn emit(lobes: &[PathLobe], out: &mut [BfrPathLobe]) -> Result<()> {
+    out.iter_mut().for_each(|o| *o = BfrPathLobe::default());
+    if lobes.len() > out.len() {
+        return Err(Error::new("internal", "more lobes than the output holds"));
+    }
+    for (o, l) in out.iter_mut().zip(lobes) {
+        *o = lobe(l);
+        if !finite(o) {
+            return Err(Error::new(
+                "internal",
+                "non-finite result (a bug: please report the input)",
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Bulk crystal lobes seen from `wi`.
+///
+/// # Safety
+/// Valid pointers; `out` holds `BFR_CRYSTAL_LOBES` entries; `message` null or writable.
+#[no_mangle]
+pub unsafe extern "C" fn bfr_crystal_lobes(
+    m: *const BfrMaterial,
+    g: *const BfrGeometry,
+    wavelength_nm: f64,
+    wi: *const f64,
+    transport_mode: i32,
+    out: *mut BfrPathLobe,
+    message: *mut c_char,
+    message_len: usize,
+) -> i32 {
+    // SAFETY: pointer contracts above.
+    unsafe {
+        guarded(message, message_len, || {
+            let (m, g) = (
+                m.as_ref().ok_or_else(|| null("material"))?,
+                g.as_ref().ok_or_else(|| null("geometry"))?,
+            );
+            if out.is_null() {
+                return Err(null("out"));
+            }
+            let out = std::slice::from_raw_parts_mut(out, BFR_CRYSTAL_LOBES);
+            let (eo, ee) = m.0.indices(wavelength_nm, g.birefringence)?;
+            let axis = Vector3::from(g.optic_axis);
+            let s = Surface::new(C64::new(g.ext_ior, 0.0), Uniaxial::new(eo, ee, axis)?)?;
+            let lobes = crystal_lobes(&s, vec3(wi, "wi")?, transport(transport_mode)?)?;
+            emit(&lobes, out)
+        })
+    }
+}
+
+fn plate_query(m: &Material, g: &BfrGeometry, flags: i32) -> Result<PlateQuery> {
+    if flags & !(BFR_WANT_REFLECTION | BFR_WANT_TRANSMISSION | BFR_INTENSITY_ONLY) != 0 {
+        return Err(Error::new("flags", format!("unknown bits in {flags}")));
+    }
+    PlateQuery::new(
+        *m,
+        g.birefringence,
+        C64::new(g.ext_ior, 0.0),
+        C64::new(g.exit_ior, 0.0),
+        Vector3::from(g.optic_axis),
+        g.thickness_nm,
+        flags & BFR_WANT_REFLECTION != 0,
+        flags & BFR_WANT_TRANSMISSION != 0,
+        flags & BFR_INTENSITY_ONLY != 0,
+    )
+}
+
+/// Plate lobes at one wavelength (exact or band-filtered).
+///
+/// # Safety
+/// Valid pointers; `out` holds 2 entries; `message` null or writable.
+#[no_mangle]
+pub unsafe extern "C" fn bfr_plate_lobes(
+    m: *const BfrMaterial,
+    g: *const BfrGeometry,
+    wavelength_nm: f64,
+    fwhm_nm: f64,
+    wi: *const f64,
+    transport_mode: i32,
+    flags: i32,
+    out: *mut BfrPathLobe,
+    message: *mut c_char,
+    message_len: usize,
+) -> i32 {
+    // SAFETY: pointer contracts above.
+    unsafe {
+        guarded(message, message_len, || {
+            let (m, g) = (
+                m.as_ref().ok_or_else(|| null("material"))?,
+                g.as_ref().ok_or_else(|| null("geometry"))?,
+            );
+            if out.is_null() {
+                return Err(null("out"));
+            }
+            let out = std::slice::from_raw_parts_mut(out, 2);
+            let q = plate_query(&m.0, g, flags)?;
+            let spectrum = Spectrum::Band {
+                wavelength_nm,
+                fwhm_nm,
+            };
+            let lobes = plate_lobes(&q, &spectrum, vec3(wi, "wi")?, transport(transport_mode)?)?;
+            emit_plate(&lobes[0], out)
+        })
+    }
+}
+
+/// Writes `[reflection, transmission]` into `out[0..2]`.
+fn emit_plate(lobes: &[Option<PathLobe>; 2], out: &mut [BfrPathLobe]) -> Result<()> {
+    for (o, l) in out.iter_mut().zip(lobes) {
+        *o = BfrPathLobe::default();
+        if let Some(l) = l {
+            *o = lobe(l);
+            if !finite(o) {
+                return Err(Error::new(
+                    "internal",
+                    "non-finite result (a bug: please report the input)",
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Plate lobes integrated over the linear sRGB (D65) channels.
+///
+/// # Safety
+/// Valid pointers; `out` holds 3 × 2 entries; `message` null or writable.
+#[no_mangle]
+pub unsafe extern "C" fn bfr_plate_lobes_rgb(
+    m: *const BfrMaterial,
+    g: *const BfrGeometry,
+    wi: *const f64,
+    transport_mode: i32,
+    flags: i32,
+    out: *mut BfrPathLobe,
+    message: *mut c_char,
+    message_len: usize,
+) -> i32 {
+    // SAFETY: pointer contracts above.
+    unsafe {
+        guarded(message, message_len, || {
+            let (m, g) = (
+                m.as_ref().ok_or_else(|| null("material"))?,
+                g.as_ref().ok_or_else(|| null("geometry"))?,
+            );
+            if out.is_null() {
+                return Err(null("out"));
+            }
+            let out = std::slice::from_raw_parts_mut(out, 6);
+            let q = plate_query(&m.0, g, flags)?;
+            let spectrum = Spectrum::Weights(WeightSet::SrgbD65);
+            let lobes = plate_lobes(&q, &spectrum, vec3(wi, "wi")?, transport(transport_mode)?)?;
+            for (c, l) in lobes.iter().enumerate() {
+                emit_plate(l, &mut out[2 * c..2 * c + 2])?;
+            }
+            Ok(())
+        })
+    }
 }
 
 /// The library's version string (static, NUL-terminated).

@@ -9,6 +9,7 @@
 //! matrix `S` of the interface: `[b; c] = S [a; d]`. This one solve covers iso→aniso,
 //! aniso→iso and aniso→aniso interfaces alike.
 
+use crate::cmath;
 use crate::error::{Error, Result};
 use crate::medium::Uniaxial;
 use crate::modes::{modes, Mode, ModeSet};
@@ -50,7 +51,7 @@ impl Interface {
         put(&mut lhs, 2, &lower.down, -1.0);
         put(&mut rhs, 0, &upper.down, -1.0);
         put(&mut rhs, 2, &lower.up, 1.0);
-        let s = lhs.lu().solve(&rhs).ok_or_else(singular)?;
+        let s = cmath::solve4(&lhs, &rhs).ok_or_else(singular)?;
         if s.iter().any(|z| !z.re.is_finite() || !z.im.is_finite()) {
             return Err(singular());
         }

@@ -6,6 +6,7 @@
 //! `n + iκ` with `κ ≥ 0`.
 
 pub mod calc;
+pub mod cmath;
 pub mod crystals;
 pub mod dispersion;
 pub mod error;
@@ -13,11 +14,14 @@ pub mod ffi;
 pub mod frame;
 pub mod interface;
 pub mod lobes;
+pub mod material;
 pub mod medium;
 pub mod modes;
 pub mod mueller;
 pub mod paths;
+pub mod sampling;
 pub mod slab;
+pub mod spectral;
 pub mod surface;
 
 pub use error::{Error, Result};

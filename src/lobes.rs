@@ -34,6 +34,8 @@ pub struct Lobe {
     pub jones: Matrix2<C64>,
     /// Its Mueller matrix in Mitsuba's convention.
     pub mueller: Matrix4<f64>,
+    /// Ray index of the outgoing wave (seed eq. S14).
+    pub ray_index: f64,
 }
 
 /// All lobes of one surface event.
@@ -43,6 +45,8 @@ pub struct Event {
     pub incident_direction: Vector3<f64>,
     /// `x` axis of the incident wave's Stokes frame.
     pub incident_stokes_x: Vector3<f64>,
+    /// Ray index of the incident wave (seed eq. S14).
+    pub incident_ray_index: f64,
     /// Outside incidence: `[exterior wave, —]`; inside: `[o, e]` (waves into the crystal).
     pub reflected: [Option<Lobe>; 2],
     /// Outside incidence: `[o, e]`; inside: `[exterior wave, —]`.
@@ -135,6 +139,9 @@ pub fn scatter(
     Ok(Event {
         incident_direction: -towards_light,
         incident_stokes_x: in_x,
+        incident_ray_index: first_in
+            .ray_index()
+            .unwrap_or(first_in.effective_index().re),
         reflected,
         transmitted,
     })
@@ -229,5 +236,6 @@ fn lobe(sv: &Solved, mode: &Mode, stokes_x: Vector3<f64>, jones: Matrix2<C64>) -
         stokes_x,
         jones,
         mueller: mueller::from_jones(&jones),
+        ray_index: mode.ray_index().unwrap_or(mode.effective_index().re),
     }
 }

@@ -7,6 +7,7 @@
 //! `q` the normal component (seed eq. S9). Lengths of wave vectors are in units of `k0`, so
 //! nothing here depends on the wavelength (the seed's "note regarding k").
 
+use crate::cmath;
 use crate::medium::Uniaxial;
 use nalgebra::Vector3;
 use num_complex::Complex64 as C64;
@@ -118,7 +119,7 @@ impl Mode {
 
     /// Effective index `sqrt(q² + β²)` seen by the wave (seed eq. S13); complex with absorption.
     pub fn effective_index(&self) -> C64 {
-        (self.q * self.q + self.beta * self.beta).sqrt()
+        cmath::sqrt(self.q * self.q + self.beta * self.beta)
     }
 
     /// Ray (phase) index along the Poynting direction, `Re(η_ef) ⟨W, I⟩` (seed eq. S14);
@@ -193,7 +194,11 @@ fn normal_squared(eta: C64, beta: C64) -> C64 {
 /// s and p modes of an isotropic medium of index `eta`.
 pub fn isotropic_modes(eta: C64, beta: C64) -> ModeSet {
     let one = C64::new(1.0, 0.0);
-    let (q_up, q_down) = up_down(one, C64::new(0.0, 0.0), normal_squared(eta, beta).sqrt());
+    let (q_up, q_down) = up_down(
+        one,
+        C64::new(0.0, 0.0),
+        cmath::sqrt(normal_squared(eta, beta)),
+    );
     let pair = |q: C64| {
         let s = Vector3::new(C64::new(0.0, 0.0), one, C64::new(0.0, 0.0));
         let p = Vector3::new(-q / eta, C64::new(0.0, 0.0), beta / eta);
@@ -225,7 +230,7 @@ fn extraordinary_q_w(medium: &Uniaxial, beta: C64) -> (C64, C64, C64) {
     let a = eo + d * ax.z * ax.z;
     let b = d * beta * ax.x * ax.z;
     let disc = eo * (ee * a - beta * beta * (ee - d * ax.y * ax.y));
-    up_down_w(a, b, disc.sqrt())
+    up_down_w(a, b, cmath::sqrt(disc))
 }
 
 /// Maximal incidence parameters `(K_o^max, K_e^max)/k0` beyond which the o and e waves are
@@ -251,17 +256,18 @@ pub fn uniaxial_modes(medium: &Uniaxial, beta: C64) -> ModeSet {
     let (qo_up, qo_down) = up_down(
         C64::new(1.0, 0.0),
         C64::new(0.0, 0.0),
-        normal_squared(medium.eta_o, beta).sqrt(),
+        cmath::sqrt(normal_squared(medium.eta_o, beta)),
     );
     let (qe_up, qe_down, w) = extraordinary_q_w(medium, beta);
     let exact_flux = medium.is_lossless() && beta.im == 0.0 && w.im == 0.0;
+    let (eps, eps_inv) = (medium.permittivity(), medium.inverse_permittivity());
     let pair = |qo: C64, qe: C64, ek_z: f64| {
         let e_o = normalize(ordinary_displacement(medium, beta, qo));
         let ke = wave_vector(beta, qe);
         let d_e = ke.cross(&ordinary_displacement(medium, beta, qe));
-        let e_e = normalize(medium.inverse_permittivity() * d_e);
+        let e_e = normalize(eps_inv * d_e);
         let e_mode = if exact_flux {
-            let kek = (ke.transpose() * medium.permittivity() * ke)[(0, 0)].re;
+            let kek = (ke.transpose() * eps * ke)[(0, 0)].re;
             Mode::lossless_e(beta, qe, e_e, ek_z, kek)
         } else {
             Mode::new(ModeKind::E, beta, qe, e_e)
@@ -279,8 +285,8 @@ fn ordinary_displacement(medium: &Uniaxial, beta: C64, q: C64) -> C3 {
     let k = wave_vector(beta, q);
     let a = medium.axis.map(|x| C64::new(x, 0.0));
     let c = k.cross(&a);
-    let scale = k.iter().map(|z| z.norm()).fold(0.0, f64::max);
-    if c.iter().map(|z| z.norm()).fold(0.0, f64::max) > 1e-12 * scale {
+    let size = |v: &C3| v.iter().map(|z| z.norm_sqr()).sum::<f64>();
+    if size(&c) > 1e-24 * size(&k) {
         c
     } else {
         Vector3::new(C64::new(0.0, 0.0), C64::new(1.0, 0.0), C64::new(0.0, 0.0))
@@ -290,7 +296,7 @@ fn ordinary_displacement(medium: &Uniaxial, beta: C64, q: C64) -> C3 {
 /// `v / |v|` with the Hermitian norm.
 fn normalize(v: C3) -> C3 {
     let n = v.iter().map(|z| z.norm_sqr()).sum::<f64>().sqrt();
-    v / C64::new(n, 0.0)
+    v * C64::new(1.0 / n, 0.0)
 }
 
 /// Wave vector (units of `k0`) of the e-wave whose ray (Poynting) direction is `ray` (unit,

@@ -11,8 +11,37 @@ use num_complex::Complex64 as C64;
 
 /// The Mueller matrix (Mitsuba's convention) of a core Jones matrix `j` (rows = output
 /// components, columns = input components, both in `(x, y)` Stokes frames).
+///
+/// Written out as `M_ij = ½ tr(σ_i J_m σ_j J_m†)` with Mitsuba's Stokes basis `σ₀ = I`,
+/// `σ₁ = diag(1, −1)`, `σ₂ = [[0,1],[1,0]]`, `σ₃ = [[0,−i],[i,0]]` (a real-arithmetic closed
+/// form; equal to `from_coherency(&coherency(j))`, which the tests check).
 pub fn from_jones(j: &Matrix2<C64>) -> Matrix4<f64> {
-    from_coherency(&coherency(j))
+    // Columns a, b of Mitsuba's Jones matrix conj(J).
+    let (a0, a1) = (j[(0, 0)].conj(), j[(1, 0)].conj());
+    let (b0, b1) = (j[(0, 1)].conj(), j[(1, 1)].conj());
+    let (p, q, r, s) = (a0.norm_sqr(), a1.norm_sqr(), b0.norm_sqr(), b1.norm_sqr());
+    let x = a1 * a0.conj();
+    let y = b1 * b0.conj();
+    let u = a1 * b0.conj();
+    let v = b1 * a0.conj();
+    let w00 = a0 * b0.conj();
+    let w11 = a1 * b1.conj();
+    let i = C64::new(0.0, 1.0);
+    // B_j = J σ_j J† as (B00, B11, B10) for j = 0..3.
+    let bs = [
+        (p + r, q + s, x + y),
+        (p - r, q - s, x - y),
+        (2.0 * w00.re, 2.0 * w11.re, u + v),
+        (2.0 * w00.im, 2.0 * w11.im, i * (v - u)),
+    ];
+    let mut m = Matrix4::zeros();
+    for (col, (b00, b11, b10)) in bs.into_iter().enumerate() {
+        m[(0, col)] = 0.5 * (b00 + b11);
+        m[(1, col)] = 0.5 * (b00 - b11);
+        m[(2, col)] = b10.re;
+        m[(3, col)] = b10.im;
+    }
+    m
 }
 
 /// The coherency superoperator `K(J) = J_m ⊗ conj(J_m) = conj(J) ⊗ J`: it maps the vectorised
@@ -81,6 +110,17 @@ mod tests {
                 assert!((got - so[r]).abs() < 1e-14, "row {r}: {got} vs {}", so[r]);
             }
         }
+    }
+
+    #[test]
+    fn closed_form_equals_the_coherency_product() {
+        let j = Matrix2::new(
+            C64::new(0.3, -0.2),
+            C64::new(-0.1, 0.5),
+            C64::new(0.7, 0.05),
+            C64::new(-0.4, -0.6),
+        );
+        assert!((from_jones(&j) - from_coherency(&coherency(&j))).norm() < 1e-14);
     }
 
     #[test]

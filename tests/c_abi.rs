@@ -2,10 +2,12 @@
 //! it links the static library, sees the same struct sizes and the same numbers as the Rust API,
 //! and gets error codes and messages for invalid input.
 
-use birefringent::ffi::{BfrComplex, BfrEvent, BfrLobe, BfrSurface};
-use birefringent::lobes::scatter;
+use birefringent::ffi::{BfrComplex, BfrGeometry, BfrMaterialDesc, BfrPathLobe};
+use birefringent::material::Material;
 use birefringent::medium::Uniaxial;
-use birefringent::surface::{Incident, Surface};
+use birefringent::sampling::{crystal_lobes, plate_lobes, PlateQuery, Spectrum, Transport};
+use birefringent::spectral::weights::WeightSet;
+use birefringent::surface::Surface;
 use birefringent::C64;
 use nalgebra::Vector3;
 use std::path::{Path, PathBuf};
@@ -24,7 +26,10 @@ fn static_lib() -> PathBuf {
         .status()
         .expect("cargo runs");
     assert!(status.success());
-    root().join("target/release/libbirefringent.a")
+    let dir = std::env::var("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|_| root().join("target"));
+    dir.join("release/libbirefringent.a")
 }
 
 fn compile_and_run(lib: &Path) -> String {
@@ -33,9 +38,7 @@ fn compile_and_run(lib: &Path) -> String {
     let exe = dir.join("abi_check");
     let cc = std::env::var("CC").unwrap_or_else(|_| "cc".into());
     let out = Command::new(cc)
-        .arg("-std=c99")
-        .arg("-Wall")
-        .arg("-Werror")
+        .args(["-std=c99", "-Wall", "-Werror"])
         .arg(format!("-I{}", root().join("cpp/include").display()))
         .arg(root().join("tests/c/abi_check.c"))
         .arg(lib)
@@ -50,7 +53,35 @@ fn compile_and_run(lib: &Path) -> String {
     );
     let run = Command::new(&exe).output().unwrap();
     assert!(run.status.success());
+    std::fs::remove_dir_all(&dir).ok();
     String::from_utf8(run.stdout).unwrap()
+}
+
+fn numbers(line: &str) -> Vec<f64> {
+    line.split(' ')
+        .skip(1)
+        .map(|x| x.parse().unwrap())
+        .collect()
+}
+
+fn expect_lobe(line: &str, l: Option<&birefringent::sampling::PathLobe>) {
+    let f = numbers(line);
+    match l {
+        None => assert_eq!(f[0], 0.0, "{line}"),
+        Some(l) => {
+            let want = [
+                1.0,
+                l.component as f64,
+                l.wo.x,
+                l.wo.y,
+                l.wo.z,
+                l.weight,
+                l.mueller[(1, 1)],
+                l.eta,
+            ];
+            assert_eq!(f, want, "C and Rust disagree");
+        }
+    }
 }
 
 #[test]
@@ -66,51 +97,84 @@ fn c_program_agrees_with_the_rust_api() {
         sizes,
         [
             std::mem::size_of::<BfrComplex>(),
-            std::mem::size_of::<BfrSurface>(),
-            std::mem::size_of::<BfrLobe>(),
-            std::mem::size_of::<BfrEvent>()
+            std::mem::size_of::<BfrMaterialDesc>(),
+            std::mem::size_of::<BfrGeometry>(),
+            std::mem::size_of::<BfrPathLobe>()
         ]
     );
     assert_eq!(lines[1], format!("version {}", env!("CARGO_PKG_VERSION")));
-    assert_eq!(lines[2], "rc 0");
+    let calcite = Material::named("calcite", 0.0, 0.0).unwrap();
+    let (eo, ee) = calcite.indices(589.3, 0.0).unwrap();
+    assert_eq!(numbers(lines[2]), [0.0, eo.re, ee.re]);
 
-    let crystal = Uniaxial::new(
-        C64::new(1.6584, 0.0),
-        C64::new(1.4864, 0.0),
-        Vector3::new(0.7021, 0.0, 0.7120),
+    let axis = Vector3::new(0.7021, 0.0, 0.7120);
+    let s = Surface::new(C64::new(1.0, 0.0), Uniaxial::new(eo, ee, axis).unwrap()).unwrap();
+    let wi = Vector3::new(0.3, 0.2, (1.0f64 - 0.13).sqrt());
+    let mut at = 3;
+    for t in [Transport::Radiance, Transport::Importance] {
+        assert_eq!(numbers(lines[at])[1], 0.0, "{}", lines[at]);
+        let lobes = crystal_lobes(&s, wi, t).unwrap();
+        for k in 0..6 {
+            expect_lobe(lines[at + 1 + k], lobes.get(k));
+        }
+        at += 7;
+    }
+    assert_eq!(lines[at], "plate 0");
+    let q = PlateQuery::new(
+        calcite,
+        0.0,
+        C64::new(1.0, 0.0),
+        C64::new(1.0, 0.0),
+        axis,
+        2500.0,
+        true,
+        true,
+        false,
     )
     .unwrap();
-    let s = Surface::new(C64::new(1.0, 0.0), crystal).unwrap();
-    let w = Vector3::new(0.3, 0.2, (1.0f64 - 0.13).sqrt());
-    let e = scatter(&s, w, Incident::Outside).unwrap();
-    let lobes = [
-        e.reflected[0],
-        e.reflected[1],
-        e.transmitted[0],
-        e.transmitted[1],
-    ];
-    for (line, lobe) in lines[3..7].iter().zip(lobes) {
-        let f: Vec<f64> = line
-            .split(' ')
-            .skip(1)
-            .map(|x| x.parse().unwrap())
-            .collect();
-        match lobe {
-            None => assert_eq!(f[0], 0.0),
-            Some(l) => {
-                assert_eq!(f[0], 1.0);
-                let want = [
-                    l.direction.x,
-                    l.direction.y,
-                    l.direction.z,
-                    l.mueller[(0, 0)],
-                    l.mueller[(1, 1)],
-                ];
-                assert_eq!(&f[2..], &want, "C and Rust disagree");
-            }
-        }
-    }
-    assert!(lines[7].starts_with("bad 1 optic_axis:"), "{}", lines[7]);
-    assert_eq!(lines[8], "truncated 1 [inciden]");
-    assert_eq!(lines[9], "null 1 null pointer argument");
+    let band = Spectrum::Band {
+        wavelength_nm: 550.0,
+        fwhm_nm: 0.0,
+    };
+    let p = plate_lobes(&q, &band, wi, Transport::Radiance).unwrap();
+    expect_lobe(lines[at + 1], p[0][0].as_ref());
+    expect_lobe(lines[at + 2], p[0][1].as_ref());
+    let q = PlateQuery::new(
+        calcite,
+        0.0,
+        C64::new(1.0, 0.0),
+        C64::new(1.0, 0.0),
+        axis,
+        2500.0,
+        false,
+        true,
+        true,
+    )
+    .unwrap();
+    let rgb = plate_lobes(
+        &q,
+        &Spectrum::Weights(WeightSet::SrgbD65),
+        wi,
+        Transport::Importance,
+    )
+    .unwrap();
+    let f = numbers(lines[at + 3]);
+    assert_eq!(
+        f,
+        [
+            0.0,
+            rgb[0][1].unwrap().weight,
+            rgb[1][1].unwrap().weight,
+            rgb[2][1].unwrap().weight,
+            0.0
+        ]
+    );
+    assert!(lines[at + 4].starts_with("bad material 1 material: unknown crystal 'unobtainium'"));
+    assert!(
+        lines[at + 5].starts_with("bad axis 1 optic_axis:"),
+        "{}",
+        lines[at + 5]
+    );
+    assert_eq!(lines[at + 6], "truncated 1 [transport]");
+    assert_eq!(lines[at + 7], "null 1 geometry: null pointer");
 }

@@ -5,28 +5,34 @@ use nalgebra::Vector3;
 use num_complex::Complex64 as C64;
 use serde_json::{Map, Value};
 
-/// A JSON object whose fields are consumed one by one; [`Fields::finish`] rejects leftovers
-/// (misspelt or unsupported fields).
+/// A JSON object read field by field. Unknown (e.g. misspelt) fields are rejected up front,
+/// before anything else is reported, since they are usually the root cause.
 pub struct Fields<'a> {
     map: &'a Map<String, Value>,
-    used: Vec<&'static str>,
 }
 
 impl<'a> Fields<'a> {
-    /// Wraps a JSON value that must be an object.
-    pub fn new(value: &'a Value) -> Result<Self> {
-        match value {
-            Value::Object(map) => Ok(Fields {
-                map,
-                used: Vec::new(),
-            }),
-            _ => Err(Error::new("input", "must be a JSON object")),
+    /// Wraps a JSON value that must be an object with only `accepted` fields.
+    pub fn new(value: &'a Value, accepted: &[&str]) -> Result<Self> {
+        let Value::Object(map) = value else {
+            return Err(Error::new("input", "must be a JSON object"));
+        };
+        let mut unknown: Vec<&String> = map
+            .keys()
+            .filter(|k| !accepted.contains(&k.as_str()))
+            .collect();
+        unknown.sort();
+        if let Some(k) = unknown.first() {
+            return Err(Error::new(
+                k.as_str(),
+                format!("unknown field (accepted: {})", accepted.join(", ")),
+            ));
         }
+        Ok(Fields { map })
     }
 
     /// The raw value of `name`, if present (and not null).
     pub fn get(&mut self, name: &'static str) -> Option<&'a Value> {
-        self.used.push(name);
         self.map.get(name).filter(|v| !v.is_null())
     }
 
@@ -64,23 +70,6 @@ impl<'a> Fields<'a> {
     /// An optional 3-vector `[x, y, z]`.
     pub fn vector3(&mut self, name: &'static str) -> Result<Option<Vector3<f64>>> {
         self.get(name).map(|v| vector3(name, v)).transpose()
-    }
-
-    /// Fails if the object has fields that were never asked for.
-    pub fn finish(self) -> Result<()> {
-        let mut unknown: Vec<&String> = self
-            .map
-            .keys()
-            .filter(|k| !self.used.contains(&k.as_str()))
-            .collect();
-        unknown.sort();
-        match unknown.first() {
-            None => Ok(()),
-            Some(k) => Err(Error::new(
-                k.as_str(),
-                format!("unknown field (accepted: {})", self.used.join(", ")),
-            )),
-        }
     }
 }
 

@@ -83,13 +83,29 @@ fn read_mode(f: &mut Fields) -> Result<ModeKind> {
     }
 }
 
+/// Fields of the `interface` subcommand.
+pub const FIELDS: [&str; 13] = [
+    "wavelength_nm",
+    "ext_ior",
+    "eta_o",
+    "eta_e",
+    "material",
+    "kappa_o",
+    "kappa_e",
+    "optic_axis",
+    "theta_deg",
+    "phi_deg",
+    "beta",
+    "side",
+    "inside_mode",
+];
+
 /// Runs the `interface` subcommand on one input object.
 pub fn run(input: &Value) -> Result<Value> {
-    let mut f = Fields::new(input)?;
+    let mut f = Fields::new(input, &FIELDS)?;
     let m = media::read(&mut f)?;
     let surface = Surface::new(m.ext, m.crystal)?;
     let inc = read_incidence(&mut f, &surface, true)?;
-    f.finish()?;
     let solved = surface.solve(inc.frame, inc.beta)?;
     let mut out = match inc.incident {
         Incident::Outside => outside(&solved)?,

@@ -3,6 +3,7 @@
 use super::input::Fields;
 use crate::crystals;
 use crate::error::{Error, Result};
+use crate::material::Material;
 use crate::medium::Uniaxial;
 use nalgebra::Vector3;
 use num_complex::Complex64 as C64;
@@ -13,8 +14,10 @@ pub struct Media {
     pub wavelength_nm: f64,
     /// Exterior (isotropic) index.
     pub ext: C64,
-    /// The crystal, optic axis in the local frame.
+    /// The crystal at `wavelength_nm`, optic axis in the local frame.
     pub crystal: Uniaxial,
+    /// Its indices as functions of wavelength.
+    pub material: Material,
 }
 
 /// Reads `wavelength_nm`, `ext_ior`, `eta_o`/`eta_e` or `material`, `kappa_o`, `kappa_e` and
@@ -24,8 +27,9 @@ pub fn read(f: &mut Fields) -> Result<Media> {
     if wavelength_nm <= 0.0 {
         return Err(Error::new("wavelength_nm", "must be > 0"));
     }
-    let ext = read_ior(f, "ext_ior", wavelength_nm)?.unwrap_or(C64::new(1.0, 0.0));
-    let (eta_o, eta_e) = read_indices(f, wavelength_nm)?;
+    let ext = read_ior(f, "ext_ior")?.unwrap_or(C64::new(1.0, 0.0));
+    let material = read_material(f)?;
+    let (eta_o, eta_e) = crystal_indices(&material, wavelength_nm)?;
     let axis = f.vector3("optic_axis")?;
     let axis = match axis {
         Some(a) => a,
@@ -42,23 +46,23 @@ pub fn read(f: &mut Fields) -> Result<Media> {
         wavelength_nm,
         ext,
         crystal,
+        material,
     })
 }
 
 /// An isotropic index given as a number, `[re, im]` or a material name (Mitsuba's IOR names).
-pub fn read_ior(f: &mut Fields, name: &'static str, wavelength_nm: f64) -> Result<Option<C64>> {
+pub fn read_ior(f: &mut Fields, name: &'static str) -> Result<Option<C64>> {
     let Some(v) = f.get(name) else {
         return Ok(None);
     };
     if let Some(s) = v.as_str() {
-        return named_ior(name, s, wavelength_nm).map(Some);
+        return named_ior(name, s).map(Some);
     }
     super::input::complex(name, v).map(Some)
 }
 
-/// An isotropic material by name: Mitsuba's IOR table, or a named crystal's ordinary index if
-/// the crystal is optically isotropic (none are) — otherwise an error listing the names.
-fn named_ior(name: &str, s: &str, _wavelength_nm: f64) -> Result<C64> {
+/// An isotropic material by name (Mitsuba's IOR table), or an error listing the names.
+fn named_ior(name: &str, s: &str) -> Result<C64> {
     crystals::isotropic_ior(s)
         .map(|n| C64::new(n, 0.0))
         .ok_or_else(|| {
@@ -72,62 +76,47 @@ fn named_ior(name: &str, s: &str, _wavelength_nm: f64) -> Result<C64> {
         })
 }
 
-/// `(η_o, η_e)` from `eta_o`/`eta_e` or `material`, plus optional `kappa_o`/`kappa_e`.
-fn read_indices(f: &mut Fields, wavelength_nm: f64) -> Result<(C64, C64)> {
-    let material = f.string("material")?;
+/// The material from `eta_o`/`eta_e` or `material`, plus optional `kappa_o`/`kappa_e`.
+fn read_material(f: &mut Fields) -> Result<Material> {
+    let name = f.string("material")?;
     let (eo, ee) = (f.complex("eta_o")?, f.complex("eta_e")?);
     let (ko, ke) = (f.number("kappa_o")?, f.number("kappa_e")?);
-    let (mut eo, mut ee) = match (material, eo, ee) {
-        (Some(m), None, None) => crystal_indices(m, wavelength_nm)?,
-        (Some(_), _, _) => {
-            return Err(Error::new(
-                "material",
-                "give either material or eta_o and eta_e, not both",
-            ))
-        }
-        (None, Some(o), Some(e)) => (o, e),
-        (None, None, None) => return Err(Error::new("eta_o", "give eta_o and eta_e, or material")),
-        (None, Some(_), None) => return Err(Error::new("eta_e", "is required with eta_o")),
-        (None, None, Some(_)) => return Err(Error::new("eta_o", "is required with eta_e")),
-    };
-    for (name, eta, kappa) in [("kappa_o", &mut eo, ko), ("kappa_e", &mut ee, ke)] {
-        if let Some(k) = kappa {
-            if eta.im != 0.0 {
-                return Err(Error::new(
+    match (name, eo, ee) {
+        (Some(m), None, None) => Material::named(m, ko.unwrap_or(0.0), ke.unwrap_or(0.0)),
+        (Some(_), _, _) => Err(Error::new(
+            "material",
+            "give either material or eta_o and eta_e, not both",
+        )),
+        (None, Some(o), Some(e)) => {
+            let add = |name: &str, eta: C64, kappa: Option<f64>| match kappa {
+                Some(_) if eta.im != 0.0 => Err(Error::new(
                     name,
                     "the index already has an imaginary part; give one or the other",
-                ));
-            }
-            eta.im = k;
+                )),
+                Some(k) => Ok(C64::new(eta.re, k)),
+                None => Ok(eta),
+            };
+            Material::constant(add("kappa_o", o, ko)?, add("kappa_e", e, ke)?)
         }
+        (None, None, None) => Err(Error::new("eta_o", "give eta_o and eta_e, or material")),
+        (None, Some(_), None) => Err(Error::new("eta_e", "is required with eta_o")),
+        (None, None, Some(_)) => Err(Error::new("eta_o", "is required with eta_e")),
     }
-    Ok((eo, ee))
 }
 
-/// Indices of a named crystal at `wavelength_nm` (error outside its fit's range).
-pub fn crystal_indices(name: &str, wavelength_nm: f64) -> Result<(C64, C64)> {
-    let c = crystals::crystal(name).ok_or_else(|| {
-        Error::new(
-            "material",
-            format!(
-                "unknown crystal '{name}' (known: {})",
-                crystals::crystal_names().join(", ")
-            ),
-        )
-    })?;
-    let (lo, hi) = c.range_nm;
-    if !(lo..=hi).contains(&wavelength_nm) {
+/// Indices of `material` at `wavelength_nm`; a named crystal must be within its fit's range.
+fn crystal_indices(material: &Material, wavelength_nm: f64) -> Result<(C64, C64)> {
+    if let Some(name) = material.out_of_range(wavelength_nm, wavelength_nm) {
+        let c = crystals::crystal(name)
+            .map(|c| c.range_nm)
+            .unwrap_or_default();
         return Err(Error::new(
             "wavelength_nm",
             format!(
-                "{wavelength_nm} nm is outside the {lo}-{hi} nm range of the dispersion data for {}",
-                c.name
+                "{wavelength_nm} nm is outside the {}-{} nm range of the dispersion data for {name}",
+                c.0, c.1
             ),
         ));
     }
-    let re = |n: f64| C64::new(n, 0.0);
-    Ok((
-        re(c.ordinary.index(wavelength_nm)),
-        re(c.extraordinary.index(wavelength_nm)),
-    ))
+    material.indices(wavelength_nm, 0.0)
 }

@@ -5,6 +5,7 @@ pub mod interface;
 pub mod media;
 pub mod output;
 pub mod slab;
+pub mod spectrum;
 
 use crate::error::{Error, Result};
 use serde_json::{json, Value};

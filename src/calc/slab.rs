@@ -6,6 +6,7 @@ use super::media;
 use super::output::{complex, num};
 use crate::error::{Error, Result};
 use crate::slab::{Slab, Want};
+use crate::spectral::plate::Plate;
 use crate::surface::Surface;
 use nalgebra::{Matrix2, Matrix4};
 use num_complex::Complex64 as C64;
@@ -13,8 +14,10 @@ use serde_json::{json, Map, Value};
 
 /// A parsed slab query.
 pub struct SlabQuery {
-    /// The slab.
+    /// The slab at `wavelength_nm`.
     pub slab: Slab,
+    /// The same plate with its (possibly dispersive) material.
+    pub plate: Plate,
     /// Vacuum wavelength (nm).
     pub wavelength_nm: f64,
     /// Plane of incidence.
@@ -33,11 +36,20 @@ pub fn read(f: &mut Fields) -> Result<SlabQuery> {
             format!("must be >= 0, got {thickness_um}"),
         ));
     }
-    let exit = media::read_ior(f, "exit_ior", m.wavelength_nm)?.unwrap_or(m.ext);
+    let exit = media::read_ior(f, "exit_ior")?.unwrap_or(m.ext);
     let surface = Surface::new(m.ext, m.crystal)?;
     let inc = read_incidence(f, &surface, false)?;
+    let slab = Slab::new(m.ext, m.crystal, exit, thickness_um * 1e3)?;
     Ok(SlabQuery {
-        slab: Slab::new(m.ext, m.crystal, exit, thickness_um * 1e3)?,
+        plate: Plate {
+            material: m.material,
+            birefringence: 0.0,
+            ext: m.ext,
+            exit,
+            axis: m.crystal.axis,
+            thickness_nm: slab.thickness_nm,
+        },
+        slab,
         wavelength_nm: m.wavelength_nm,
         frame: inc.frame,
         beta: inc.beta,
@@ -46,9 +58,28 @@ pub fn read(f: &mut Fields) -> Result<SlabQuery> {
 
 /// Runs the `slab` subcommand on one input object.
 pub fn run(input: &Value) -> Result<Value> {
-    let mut f = Fields::new(input)?;
+    let fields = slab_fields();
+    let spectrum = Fields::new(input, &fields)?.get("spectrum");
+    match spectrum {
+        None => run_monochromatic(input, &fields),
+        Some(spec) => super::spectrum::run(input, &fields, spec),
+    }
+}
+
+/// The accepted fields of `slab`.
+pub fn slab_fields() -> Vec<&'static str> {
+    super::interface::FIELDS
+        .iter()
+        .filter(|f| **f != "inside_mode")
+        .chain(&["thickness_um", "exit_ior", "spectrum"])
+        .copied()
+        .collect()
+}
+
+/// The slab at exactly `wavelength_nm`.
+fn run_monochromatic(input: &Value, fields: &[&str]) -> Result<Value> {
+    let mut f = Fields::new(input, fields)?;
     let q = read(&mut f)?;
-    f.finish()?;
     let optics = q.slab.optics(&q.frame, q.beta)?;
     let j = optics.jones(q.wavelength_nm, Want::BOTH)?;
     let (r, t) = (j.r.unwrap_or_default(), j.t.unwrap_or_default());

@@ -1,0 +1,206 @@
+/* `thinbirefringent`: a plane-parallel uniaxial plate on a surface (like `thindielectric`).
+ *
+ * Components: 0 specular reflection (DeltaReflection), 1 straight-through transmission (Null when
+ * exit_ior == ext_ior, else DeltaTransmission in the direction the core returns). Both carry the
+ * plate's full Mueller matrix, multiple internal reflections included. Parameters: see
+ * plugin/README.md. The physics is the core's bfr_plate_lobes / bfr_plate_lobes_rgb.
+ */
+#include "common.h"
+
+NAMESPACE_BEGIN(mitsuba)
+
+template <typename Float, typename Spectrum>
+class ThinBirefringent final : public BSDF<Float, Spectrum> {
+public:
+    MI_IMPORT_BASE(BSDF, m_flags, m_components)
+    MI_IMPORT_TYPES(Texture)
+    using Lobes = bfr::Lobes<Float, Spectrum>;
+
+    /// Default `filter_bandwidth` (nm, FWHM) of the spectral variants.
+    static constexpr double DefaultFilterBandwidth = 4.0;
+
+    ThinBirefringent(const Properties &props) : Base(props) {
+        m_params = bfr::parse_material(props, ClassName);
+        m_ext_ior = bfr::parse_ior(props, "ext_ior", "air", ClassName);
+        m_exit_ior = props.has_property("exit_ior")
+                         ? bfr::parse_ior(props, "exit_ior", "air", ClassName)
+                         : m_ext_ior;
+        m_optic_axis = props.get<ScalarVector3f>("optic_axis", ScalarVector3f(1.f, 0.f, 0.f));
+        m_thickness = props.get_unbounded_texture<Texture>("thickness", 1.f);
+        m_thickness_scale = props.get<double>("thickness_scale", 1.0);
+        if (props.has_property("birefringence"))
+            m_birefringence = props.get_unbounded_texture<Texture>("birefringence", 0.f);
+        m_birefringence_scale = props.get<double>("birefringence_scale", 1.0);
+        if (props.has_property("axis_angle"))
+            m_axis_angle = props.get_unbounded_texture<Texture>("axis_angle", 0.f);
+        m_filter_bandwidth = props.get<double>("filter_bandwidth", DefaultFilterBandwidth);
+        parameters_changed();
+    }
+
+    void traverse(TraversalCallback *cb) override {
+        if (m_params.material.empty()) {
+            cb->put("eta_o", m_params.eta_o, ParamFlags::NonDifferentiable);
+            cb->put("eta_e", m_params.eta_e, ParamFlags::NonDifferentiable);
+        }
+        cb->put("kappa_o", m_params.kappa_o, ParamFlags::NonDifferentiable);
+        cb->put("kappa_e", m_params.kappa_e, ParamFlags::NonDifferentiable);
+        cb->put("ext_ior", m_ext_ior, ParamFlags::NonDifferentiable);
+        cb->put("exit_ior", m_exit_ior, ParamFlags::NonDifferentiable);
+        cb->put("optic_axis", m_optic_axis, ParamFlags::NonDifferentiable);
+        cb->put("thickness", m_thickness, ParamFlags::NonDifferentiable);
+        cb->put("thickness_scale", m_thickness_scale, ParamFlags::NonDifferentiable);
+        if (m_birefringence)
+            cb->put("birefringence", m_birefringence, ParamFlags::NonDifferentiable);
+        cb->put("birefringence_scale", m_birefringence_scale, ParamFlags::NonDifferentiable);
+        if (m_axis_angle)
+            cb->put("axis_angle", m_axis_angle, ParamFlags::NonDifferentiable);
+        cb->put("filter_bandwidth", m_filter_bandwidth, ParamFlags::NonDifferentiable);
+    }
+
+    /// Rebuilds the core material and the flags, and checks every parameter with one core query
+    /// (textures at their mean), so that invalid input fails here, with the core's message.
+    void parameters_changed(const std::vector<std::string> & /*keys*/ = {}) override {
+        m_material = bfr::make_material(m_params, ClassName);
+        m_null = m_exit_ior == m_ext_ior;
+        uint32_t aniso = (m_params.isotropic() && !m_birefringence) ? 0u : (uint32_t) BSDFFlags::Anisotropic;
+        uint32_t sides = (uint32_t) (BSDFFlags::FrontSide | BSDFFlags::BackSide) | aniso;
+        m_types[0] = BSDFFlags::DeltaReflection;
+        m_types[1] = m_null ? BSDFFlags::Null : BSDFFlags::DeltaTransmission;
+        m_components.clear();
+        m_components.push_back((uint32_t) m_types[0] | sides);
+        m_components.push_back((uint32_t) m_types[1] | sides);
+        m_flags = m_components[0] | m_components[1];
+
+        bfr_geometry g = geometry(m_thickness->mean(), m_birefringence ? m_birefringence->mean() : 0.0,
+                                  m_axis_angle ? m_axis_angle->mean() : 0.0);
+        const double wi[3] = { 0.0, 0.0, 1.0 };
+        bfr_path_lobe out[2];
+        char message[bfr::MessageLen] = { 0 };
+        int32_t rc = bfr_plate_lobes(m_material.get(), &g, 550.0, m_filter_bandwidth, wi,
+                                     BFR_RADIANCE, BFR_WANT_REFLECTION | BFR_WANT_TRANSMISSION,
+                                     out, message, sizeof(message));
+        if (rc != BFR_OK)
+            Throw("%s", bfr::core_error(rc, message));
+    }
+
+    std::pair<BSDFSample3f, Spectrum> sample(const BSDFContext &ctx, const SurfaceInteraction3f &si,
+                                             Float sample1, const Point2f & /*sample2*/,
+                                             Mask active) const override {
+        MI_MASKED_FUNCTION(ProfilerPhase::BSDFSample, active);
+        int32_t want = (ctx.is_enabled(m_types[0], 0) ? BFR_WANT_REFLECTION : 0) |
+                       (ctx.is_enabled(m_types[1], 1) ? BFR_WANT_TRANSMISSION : 0);
+        bfr_path_lobe lobes[Lobes::Channels * 2];
+        if (!active || !want || !query(si, ctx.mode, want, lobes))
+            return { dr::zeros<BSDFSample3f>(), dr::zeros<Spectrum>() };
+        return Lobes::sample(ctx, si, sample1, lobes, 2, m_types, 2);
+    }
+
+    Spectrum eval(const BSDFContext &, const SurfaceInteraction3f &, const Vector3f &,
+                  Mask) const override {
+        return dr::zeros<Spectrum>();  // delta lobes only
+    }
+
+    Float pdf(const BSDFContext &, const SurfaceInteraction3f &, const Vector3f &,
+              Mask) const override {
+        return 0.f;
+    }
+
+    /// The transmission matrix for light travelling along si.wi (shadow rays of volpath).
+    Spectrum eval_null_transmission(const SurfaceInteraction3f &si, Mask active) const override {
+        MI_MASKED_FUNCTION(ProfilerPhase::BSDFEvaluate, active);
+        bfr_path_lobe lobes[Lobes::Channels * 2];
+        if (!m_null || !active ||
+            !query(si, TransportMode::Radiance, BFR_WANT_TRANSMISSION, lobes))
+            return dr::zeros<Spectrum>();
+        int pick[Lobes::Channels];
+        for (size_t ch = 0; ch < Lobes::Channels; ++ch)
+            pick[ch] = lobes[ch * 2 + 1].exists ? 1 : -1;
+        return Lobes::spectrum(lobes, 2, pick, 1.0, si.wi, -si.wi, true);
+    }
+
+    std::string to_string() const override {
+        std::ostringstream oss;
+        oss << "ThinBirefringent[" << std::endl
+            << "  " << m_params.to_string() << "," << std::endl
+            << "  ext_ior = " << m_ext_ior << ", exit_ior = " << m_exit_ior << "," << std::endl
+            << "  optic_axis = " << m_optic_axis << "," << std::endl
+            << "  thickness = " << string::indent(m_thickness) << " (um)," << std::endl
+            << "  thickness_scale = " << m_thickness_scale << "," << std::endl;
+        if (m_birefringence)
+            oss << "  birefringence = " << string::indent(m_birefringence) << "," << std::endl
+                << "  birefringence_scale = " << m_birefringence_scale << "," << std::endl;
+        if (m_axis_angle)
+            oss << "  axis_angle = " << string::indent(m_axis_angle) << " (degrees)," << std::endl;
+        oss << "  filter_bandwidth = " << m_filter_bandwidth << " (nm FWHM, spectral variants)" << std::endl
+            << "]";
+        return oss.str();
+    }
+
+    MI_DECLARE_CLASS(ThinBirefringent)
+
+private:
+    /// Geometry from the texture values: thickness (um, before scaling), birefringence (before
+    /// scaling), axis angle (degrees).
+    bfr_geometry geometry(double thickness_um, double birefringence, double angle_deg) const {
+        bfr_geometry g{};
+        g.ext_ior = m_ext_ior;
+        g.exit_ior = m_exit_ior;
+        const double axis[3] = { m_optic_axis.x(), m_optic_axis.y(), m_optic_axis.z() };
+        bfr::rotate_about_normal(axis, angle_deg, g.optic_axis);
+        g.thickness_nm = 1000.0 * m_thickness_scale * thickness_um;
+        g.birefringence = m_birefringence_scale * birefringence;
+        return g;
+    }
+
+    /// Core query at si: lobes[ch * 2 + i] for channel ch, lobe i (0 R, 1 T). False (after one
+    /// warning) if the core refuses, e.g. a texture gives a negative thickness.
+    bool query(const SurfaceInteraction3f &si, TransportMode mode, int32_t want,
+               bfr_path_lobe *lobes) const {
+        bfr_geometry g = geometry(m_thickness->eval_1(si),
+                                  m_birefringence ? (double) m_birefringence->eval_1(si) : 0.0,
+                                  m_axis_angle ? (double) m_axis_angle->eval_1(si) : 0.0);
+        const double wi[3] = { si.wi.x(), si.wi.y(), si.wi.z() };
+        int32_t transport = mode == TransportMode::Radiance ? BFR_RADIANCE : BFR_IMPORTANCE;
+        int32_t flags = want | (is_polarized_v<Spectrum> ? 0 : BFR_INTENSITY_ONLY);
+        char message[bfr::MessageLen] = { 0 };
+        int32_t rc = BFR_OK;
+        if constexpr (is_rgb_v<Spectrum>) {
+            bfr_path_lobe rgb[3][2];
+            rc = bfr_plate_lobes_rgb(m_material.get(), &g, wi, transport, flags, rgb, message,
+                                     sizeof(message));
+            for (size_t ch = 0; ch < 3; ++ch)
+                for (size_t i = 0; i < 2; ++i)
+                    lobes[ch * 2 + i] = rgb[ch][i];
+        } else {
+            for (size_t ch = 0; ch < Lobes::Channels && rc == BFR_OK; ++ch)
+                rc = bfr_plate_lobes(m_material.get(), &g, (double) si.wavelengths[ch],
+                                     m_filter_bandwidth, wi, transport, flags, &lobes[ch * 2],
+                                     message, sizeof(message));
+        }
+        if (rc != BFR_OK) {
+            if (!m_warned.exchange(true))
+                Log(Warn, "%s (returning no light; further errors are not reported)",
+                    bfr::core_error(rc, message));
+            return false;
+        }
+        return true;
+    }
+
+    bfr::MaterialParams m_params;
+    bfr::MaterialPtr m_material;
+    double m_ext_ior, m_exit_ior;
+    ScalarVector3f m_optic_axis;
+    ref<Texture> m_thickness, m_birefringence, m_axis_angle;
+    double m_thickness_scale, m_birefringence_scale, m_filter_bandwidth;
+    bool m_null = true;
+    BSDFFlags m_types[2];
+    mutable std::atomic<bool> m_warned { false };
+
+    MI_TRAVERSE_CB(Base, m_thickness, m_birefringence, m_axis_angle)
+};
+
+NAMESPACE_BEGIN(bfr)
+void register_thinbirefringent() { register_plugin<ThinBirefringent>("thinbirefringent"); }
+NAMESPACE_END(bfr)
+
+NAMESPACE_END(mitsuba)

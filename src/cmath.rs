@@ -1,0 +1,109 @@
+//! Fast complex elementary functions and small dense solves used on hot paths.
+
+use nalgebra::Matrix4;
+use num_complex::Complex64 as C64;
+
+/// Principal square root (`Re ≥ 0`, branch cut on the negative real axis, `sqrt(−x ± 0i) =
+/// ±i√x`), by the algebraic formula without trigonometry and without cancellation.
+#[inline]
+pub fn sqrt(z: C64) -> C64 {
+    if z.im == 0.0 {
+        return if z.re >= 0.0 {
+            C64::new(z.re.sqrt(), z.im)
+        } else {
+            C64::new(0.0, (-z.re).sqrt().copysign(z.im))
+        };
+    }
+    let m = z.re.hypot(z.im);
+    if z.re >= 0.0 {
+        let t = (0.5 * (m + z.re)).sqrt();
+        C64::new(t, z.im / (2.0 * t))
+    } else {
+        let t = (0.5 * (m - z.re)).sqrt();
+        C64::new(z.im.abs() / (2.0 * t), t.copysign(z.im))
+    }
+}
+
+/// Solves `A X = B` for a 4×4 complex `A` and 4×4 `B` by Gaussian elimination with partial
+/// pivoting; `None` if `A` is singular to working precision.
+pub fn solve4(a: &Matrix4<C64>, b: &Matrix4<C64>) -> Option<Matrix4<C64>> {
+    // Rows of the augmented system [A | B].
+    let mut m = [[C64::new(0.0, 0.0); 8]; 4];
+    for (i, row) in m.iter_mut().enumerate() {
+        for j in 0..4 {
+            row[j] = a[(i, j)];
+            row[4 + j] = b[(i, j)];
+        }
+    }
+    let scale = a.iter().map(|z| z.norm_sqr()).fold(0.0, f64::max);
+    for col in 0..4 {
+        let mut pivot = col;
+        for i in col + 1..4 {
+            if m[i][col].norm_sqr() > m[pivot][col].norm_sqr() {
+                pivot = i;
+            }
+        }
+        let p = m[pivot][col];
+        if p.norm_sqr().is_nan() || p.norm_sqr() <= 1e-300 * scale {
+            return None;
+        }
+        m.swap(col, pivot);
+        let inv = p.inv();
+        let pivot_row = {
+            let r = &mut m[col];
+            for v in r.iter_mut().skip(col) {
+                *v *= inv;
+            }
+            *r
+        };
+        for (i, row) in m.iter_mut().enumerate() {
+            if i == col {
+                continue;
+            }
+            let f = row[col];
+            for j in col..8 {
+                row[j] -= f * pivot_row[j];
+            }
+        }
+    }
+    Some(Matrix4::from_fn(|i, j| m[i][4 + j]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sqrt_matches_the_principal_branch() {
+        for (re, im) in [
+            (2.0, 0.0),
+            (-2.0, 0.0),
+            (-2.0, -0.0),
+            (0.0, 0.0),
+            (1e-300, 3.0),
+            (-4.0, 1e-20),
+            (-4.0, -1e-20),
+            (3.0, -4.0),
+            (-3.0, 4.0),
+        ] {
+            let z = C64::new(re, im);
+            let (a, b) = (sqrt(z), z.sqrt());
+            assert!(
+                (a - b).norm() <= 1e-15 * b.norm().max(1e-300),
+                "{z}: {a} vs {b}"
+            );
+            assert!((a * a - z).norm() <= 1e-15 * z.norm().max(1e-300));
+        }
+    }
+
+    #[test]
+    fn solve4_inverts() {
+        let a = Matrix4::from_fn(|i, j| {
+            C64::new((i * 3 + j) as f64 % 5.0 - 1.7, (i + 2 * j) as f64 % 3.0)
+        });
+        let b = Matrix4::from_fn(|i, j| C64::new(i as f64 - j as f64, 0.5));
+        let x = solve4(&a, &b).unwrap();
+        assert!((a * x - b).norm() < 1e-12);
+        assert!(solve4(&Matrix4::zeros(), &b).is_none());
+    }
+}

@@ -1,0 +1,138 @@
+//! A uniaxial material: its two principal complex indices as functions of wavelength.
+
+use crate::crystals::{self, Crystal};
+use crate::error::{Error, Result};
+use crate::medium::check_index;
+use num_complex::Complex64 as C64;
+
+/// One principal index: `n(λ) + iκ`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Index {
+    /// Wavelength-independent.
+    Constant(C64),
+    /// A named crystal's ordinary or extraordinary dispersion, plus a constant extinction.
+    Crystal {
+        /// The crystal's dispersion data.
+        crystal: &'static Crystal,
+        /// `true` for the extraordinary index.
+        extraordinary: bool,
+        /// Extinction coefficient κ.
+        kappa: f64,
+    },
+}
+
+impl Index {
+    /// The complex index at `lambda_nm`. Crystal fits are evaluated outside their range too
+    /// (see [`Material::out_of_range`]).
+    pub fn at(&self, lambda_nm: f64) -> C64 {
+        match *self {
+            Index::Constant(n) => n,
+            Index::Crystal {
+                crystal,
+                extraordinary,
+                kappa,
+            } => {
+                let d = if extraordinary {
+                    &crystal.extraordinary
+                } else {
+                    &crystal.ordinary
+                };
+                C64::new(d.index(lambda_nm), kappa)
+            }
+        }
+    }
+
+    /// True if the index varies with wavelength.
+    pub fn is_dispersive(&self) -> bool {
+        matches!(self, Index::Crystal { .. })
+    }
+}
+
+/// Ordinary and extraordinary indices of a uniaxial material.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Material {
+    /// Ordinary index.
+    pub eta_o: Index,
+    /// Extraordinary index.
+    pub eta_e: Index,
+}
+
+impl Material {
+    /// Constant indices (validated).
+    pub fn constant(eta_o: C64, eta_e: C64) -> Result<Self> {
+        Ok(Material {
+            eta_o: Index::Constant(check_index("eta_o", eta_o)?),
+            eta_e: Index::Constant(check_index("eta_e", eta_e)?),
+        })
+    }
+
+    /// A named crystal with extinction coefficients `kappa_o`, `kappa_e`.
+    pub fn named(name: &str, kappa_o: f64, kappa_e: f64) -> Result<Self> {
+        let crystal = crystals::crystal(name).ok_or_else(|| {
+            Error::new(
+                "material",
+                format!(
+                    "unknown crystal '{name}' (known: {})",
+                    crystals::crystal_names().join(", ")
+                ),
+            )
+        })?;
+        for (p, k) in [("kappa_o", kappa_o), ("kappa_e", kappa_e)] {
+            if !(k.is_finite() && k >= 0.0) {
+                return Err(Error::new(p, format!("must be finite and >= 0, got {k}")));
+            }
+        }
+        let index = |extraordinary, kappa| Index::Crystal {
+            crystal,
+            extraordinary,
+            kappa,
+        };
+        Ok(Material {
+            eta_o: index(false, kappa_o),
+            eta_e: index(true, kappa_e),
+        })
+    }
+
+    /// `(η_o, η_e)` at `lambda_nm`, with `birefringence` added to `Re η_e` (photoelastic
+    /// stress: `n_e − n_o = C (σ₁ − σ₂)` on an isotropic material). Fails (naming the
+    /// parameter) if the result is not a valid index.
+    pub fn indices(&self, lambda_nm: f64, birefringence: f64) -> Result<(C64, C64)> {
+        if !(lambda_nm.is_finite() && lambda_nm > 0.0) {
+            return Err(Error::new(
+                "wavelength_nm",
+                format!("must be > 0, got {lambda_nm}"),
+            ));
+        }
+        if !birefringence.is_finite() {
+            return Err(Error::new("birefringence", "must be finite"));
+        }
+        let eo = check_index("eta_o", self.eta_o.at(lambda_nm))?;
+        let ee = self.eta_e.at(lambda_nm) + birefringence;
+        let ee = check_index(
+            if birefringence == 0.0 {
+                "eta_e"
+            } else {
+                "birefringence"
+            },
+            ee,
+        )?;
+        Ok((eo, ee))
+    }
+
+    /// True if any index varies with wavelength.
+    pub fn is_dispersive(&self) -> bool {
+        self.eta_o.is_dispersive() || self.eta_e.is_dispersive()
+    }
+
+    /// The crystal whose dispersion fit does not cover `[lo, hi]` nm, if any.
+    pub fn out_of_range(&self, lo: f64, hi: f64) -> Option<&'static str> {
+        [self.eta_o, self.eta_e].iter().find_map(|i| match i {
+            Index::Crystal { crystal, .. }
+                if crystal.range_nm.0 > lo || crystal.range_nm.1 < hi =>
+            {
+                Some(crystal.name)
+            }
+            _ => None,
+        })
+    }
+}

@@ -1,0 +1,402 @@
+//! Lobes as a path tracer samples them: given the direction `wi` a renderer looks from and
+//! its transport mode, every direction `wo` light can come from (Radiance) or go to
+//! (Importance), with the physical Mueller matrix of that transfer in explicit Stokes frames.
+//!
+//! Physically the light always arrives along `−wo_hat` and leaves along `wi_hat`, with
+//! `(wo_hat, wi_hat) = (wo, wi)` in Radiance mode and `(wi, wo)` in Importance mode (Mitsuba's
+//! convention). Importance mode is the forward problem. Radiance mode needs the sources of the
+//! light that leaves along `wi`: by time reversal (lossless reciprocity of the ray geometry),
+//! they are the reversed outgoing rays of a wave sent along `−wi`; for each, the forward
+//! problem is then solved from that source and the outgoing wave along `wi` is kept.
+
+use crate::error::{Error, Result};
+use crate::frame::PlaneFrame;
+use crate::lobes::{scatter, Event, Lobe};
+use crate::material::Material;
+use crate::medium::{check_clear_index, Uniaxial};
+use crate::modes::ModeKind;
+use crate::slab::{SlabMueller, Want};
+use crate::spectral::integrate::{integrate, narrow_band, Output};
+use crate::spectral::plate::Plate;
+use crate::spectral::weights::{gaussians, Gaussian, WeightSet};
+use crate::surface::{Incident, Surface};
+use nalgebra::{Matrix4, Vector3};
+use num_complex::Complex64 as C64;
+
+/// Mitsuba's transport modes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Transport {
+    /// Paths traced from the camera.
+    Radiance,
+    /// Paths traced from the lights.
+    Importance,
+}
+
+/// One sampled lobe.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PathLobe {
+    /// Crystal: 0 reflection, 1 ordinary, 2 extraordinary transmission; plate: 0 R, 1 T.
+    pub component: usize,
+    /// Mitsuba's `wo` (unit, local).
+    pub wo: Vector3<f64>,
+    /// `x` axis of the Stokes frame of the light arriving along `−wo_hat`.
+    pub in_stokes_x: Vector3<f64>,
+    /// `x` axis of the Stokes frame of the light leaving along `wi_hat`.
+    pub out_stokes_x: Vector3<f64>,
+    /// Physical Mueller matrix (Mitsuba's convention); in Radiance mode scaled by
+    /// `(n_wi / n_wo)²` (radiance across an index step, ray indices of seed eq. S14).
+    pub mueller: Matrix4<f64>,
+    /// `mueller[(0,0)]`, the unpolarised throughput used to pick a lobe.
+    pub weight: f64,
+    /// Mitsuba's `bs.eta`: ray index on the `wo` side over the `wi` side.
+    pub eta: f64,
+}
+
+/// The forward events of light arriving along `−towards` (exterior, or each crystal mode that
+/// can travel there), with the incident crystal mode.
+fn forward_events(
+    surface: &Surface,
+    towards: Vector3<f64>,
+) -> Result<Vec<(Option<ModeKind>, Event)>> {
+    if towards.z > 0.0 {
+        return Ok(vec![(None, scatter(surface, towards, Incident::Outside)?)]);
+    }
+    let kinds: &[ModeKind] = if surface.crystal.is_isotropic() {
+        &[ModeKind::O]
+    } else {
+        &[ModeKind::O, ModeKind::E]
+    };
+    kinds
+        .iter()
+        .map(|&k| Ok((Some(k), scatter(surface, towards, Incident::Inside(k))?)))
+        .collect()
+}
+
+/// The outgoing lobes of an event whose incident crystal mode is `incident` (`None`: from
+/// the exterior): `(component, crystal mode of the outgoing wave or None if exterior, lobe)`.
+/// Reflections are component 0; a transmission is 1 or 2 by its crystal-side mode.
+fn outgoing(event: &Event, incident: Option<ModeKind>) -> Vec<(usize, Option<ModeKind>, Lobe)> {
+    let by_mode = |m: ModeKind| if m == ModeKind::E { 2 } else { 1 };
+    let mut v = Vec::new();
+    for l in event.reflected.iter().flatten() {
+        v.push((0, incident.map(|_| l.kind), *l));
+    }
+    for l in event.transmitted.iter().flatten() {
+        match incident {
+            None => v.push((by_mode(l.kind), Some(l.kind), *l)),
+            Some(m) => v.push((by_mode(m), None, *l)),
+        }
+    }
+    v
+}
+
+/// Lobes of a bulk crystal surface seen from `wi` (unit, local; `wi.z < 0` is inside).
+pub fn crystal_lobes(
+    surface: &Surface,
+    wi: Vector3<f64>,
+    transport: Transport,
+) -> Result<Vec<PathLobe>> {
+    if !(wi.iter().all(|x| x.is_finite()) && (wi.norm() - 1.0).abs() < 1e-4) {
+        return Err(Error::new("wi", "must be a unit vector"));
+    }
+    if wi.z == 0.0 {
+        return Ok(Vec::new());
+    }
+    let wi = wi.normalize();
+    let mut lobes = Vec::new();
+    for (inc, event) in forward_events(surface, wi)? {
+        for (component, mode, l) in outgoing(&event, inc) {
+            match transport {
+                Transport::Importance => lobes.push(PathLobe {
+                    component,
+                    wo: l.direction,
+                    in_stokes_x: event.incident_stokes_x,
+                    out_stokes_x: l.stokes_x,
+                    mueller: l.mueller,
+                    weight: l.mueller[(0, 0)],
+                    eta: l.ray_index / event.incident_ray_index,
+                }),
+                Transport::Radiance => {
+                    if let Some(p) = radiance_lobe(surface, wi, inc, l.direction, mode)? {
+                        lobes.push(p);
+                    }
+                }
+            }
+        }
+    }
+    Ok(lobes)
+}
+
+/// The physical transfer from the source at `wo` (found by time reversal) into the wave that
+/// leaves along `wi` in mode `wi_mode` (`None` outside the crystal).
+fn radiance_lobe(
+    surface: &Surface,
+    wi: Vector3<f64>,
+    wi_mode: Option<ModeKind>,
+    wo: Vector3<f64>,
+    wo_mode: Option<ModeKind>,
+) -> Result<Option<PathLobe>> {
+    let incident = match wo_mode {
+        None => Incident::Outside,
+        Some(_) if surface.crystal.is_isotropic() => Incident::Inside(ModeKind::O),
+        Some(m) => Incident::Inside(m),
+    };
+    let event = match scatter(surface, wo, incident) {
+        Ok(e) => e,
+        Err(_) => return Ok(None), // grazing source: carries no power
+    };
+    let source = match incident {
+        Incident::Inside(k) => Some(k),
+        Incident::Outside => None,
+    };
+    let iso = surface.crystal.is_isotropic();
+    let found = outgoing(&event, source)
+        .into_iter()
+        .find(|(_, mode, l)| (l.direction - wi).norm() < 1e-6 && (iso || *mode == wi_mode));
+    Ok(found.map(|(component, _, l)| {
+        let scale = (l.ray_index / event.incident_ray_index).powi(2);
+        let mueller = l.mueller * scale;
+        PathLobe {
+            component,
+            wo,
+            in_stokes_x: event.incident_stokes_x,
+            out_stokes_x: l.stokes_x,
+            mueller,
+            weight: mueller[(0, 0)],
+            eta: event.incident_ray_index / l.ray_index,
+        }
+    }))
+}
+
+/// A plate query: everything but the direction and the spectrum.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlateQuery {
+    /// The plate (top = the exterior side, `z > 0`).
+    pub plate: Plate,
+    /// Which lobes to compute.
+    pub want: Want,
+    /// Only `M00`.
+    pub output: Output,
+}
+
+/// Over which spectrum a plate query is evaluated.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Spectrum {
+    /// One wavelength: exact if `fwhm_nm == 0`, else a Gaussian band of that FWHM (closed form).
+    Band {
+        /// Centre wavelength (nm).
+        wavelength_nm: f64,
+        /// Full width at half maximum (nm).
+        fwhm_nm: f64,
+    },
+    /// Every channel of a weight set (closed form).
+    Weights(WeightSet),
+}
+
+impl PlateQuery {
+    /// A validated query.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        material: Material,
+        birefringence: f64,
+        ext: C64,
+        exit: C64,
+        axis: Vector3<f64>,
+        thickness_nm: f64,
+        reflection: bool,
+        transmission: bool,
+        intensity_only: bool,
+    ) -> Result<Self> {
+        let plate = Plate {
+            material,
+            birefringence,
+            ext: check_clear_index("ext_ior", ext)?,
+            exit: check_clear_index("exit_ior", exit)?,
+            axis: Uniaxial::new(C64::new(1.0, 0.0), C64::new(1.5, 0.0), axis)?.axis,
+            thickness_nm,
+        };
+        if !(thickness_nm.is_finite() && thickness_nm >= 0.0) {
+            return Err(Error::new(
+                "thickness",
+                format!("must be finite and >= 0, got {} µm", thickness_nm * 1e-3),
+            ));
+        }
+        Ok(PlateQuery {
+            plate,
+            want: Want {
+                reflection,
+                transmission,
+            },
+            output: if intensity_only {
+                Output::Intensity
+            } else {
+                Output::Mueller
+            },
+        })
+    }
+
+    /// The same plate seen from below: exterior and exit swapped, mirrored through `z = 0`.
+    fn flipped(&self) -> Self {
+        let mut q = *self;
+        q.plate.ext = self.plate.exit;
+        q.plate.exit = self.plate.ext;
+        q.plate.axis.z = -q.plate.axis.z;
+        q
+    }
+}
+
+/// The plate's lobes seen from `wi`, one `[reflection, transmission]` pair per spectral
+/// channel (one for [`Spectrum::Band`]).
+pub fn plate_lobes(
+    q: &PlateQuery,
+    spectrum: &Spectrum,
+    wi: Vector3<f64>,
+    transport: Transport,
+) -> Result<Vec<[Option<PathLobe>; 2]>> {
+    if !(wi.iter().all(|x| x.is_finite()) && (wi.norm() - 1.0).abs() < 1e-4) {
+        return Err(Error::new("wi", "must be a unit vector"));
+    }
+    let channels = match spectrum {
+        Spectrum::Band { .. } => 1,
+        Spectrum::Weights(_) => 3,
+    };
+    let mut out = vec![[None, None]; channels];
+    if wi.z == 0.0 {
+        return Ok(out);
+    }
+    let wi = wi.normalize();
+    let reflected = Vector3::new(-wi.x, -wi.y, wi.z);
+    let through = through_plate(q, wi);
+    let lobes = [(0, Some(reflected)), (1, through)];
+    for (component, wo) in lobes {
+        let wanted = if component == 0 {
+            q.want.reflection
+        } else {
+            q.want.transmission
+        };
+        let Some(wo) = wo.filter(|_| wanted) else {
+            continue;
+        };
+        let towards = match transport {
+            Transport::Importance => wi,
+            Transport::Radiance => wo,
+        };
+        let want = Want {
+            reflection: component == 0,
+            transmission: component == 1,
+        };
+        let ms = physical_plate(q, spectrum, towards, want)?;
+        let (n_in, n_out) = side_indices(q, towards, component);
+        let scale = match transport {
+            Transport::Radiance => (n_out / n_in).powi(2),
+            Transport::Importance => 1.0,
+        };
+        let s = PlaneFrame::from_direction(towards).s;
+        for (c, (m, _)) in ms.iter().enumerate() {
+            let m = if component == 0 { m.r } else { m.t };
+            let Some(m) = m else { continue };
+            let mueller = m * scale;
+            out[c][component] = Some(PathLobe {
+                component,
+                wo,
+                in_stokes_x: s,
+                out_stokes_x: s,
+                mueller,
+                weight: mueller[(0, 0)],
+                eta: match transport {
+                    Transport::Radiance => n_in / n_out,
+                    Transport::Importance => n_out / n_in,
+                },
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// Real indices `(n where the light arrives from, n where it leaves into)`.
+fn side_indices(q: &PlateQuery, towards: Vector3<f64>, component: usize) -> (f64, f64) {
+    let (near, far) = if towards.z > 0.0 {
+        (q.plate.ext.re, q.plate.exit.re)
+    } else {
+        (q.plate.exit.re, q.plate.ext.re)
+    };
+    (near, if component == 0 { near } else { far })
+}
+
+/// The direction on the far side of the plate that is joined to `w` by transmission (Snell's
+/// law between the two isotropic media; `None` under total internal reflection).
+fn through_plate(q: &PlateQuery, w: Vector3<f64>) -> Option<Vector3<f64>> {
+    let (n_near, n_far) = side_indices(q, w, 1);
+    let ratio = n_near / n_far;
+    let sin2 = ratio * ratio * (w.x * w.x + w.y * w.y);
+    if sin2 >= 1.0 {
+        return None;
+    }
+    let cos = (1.0 - sin2).sqrt();
+    Some(Vector3::new(
+        -w.x * ratio,
+        -w.y * ratio,
+        -w.z.signum() * cos,
+    ))
+}
+
+/// Mueller matrices (s/p frames) of light arriving from `towards` (either side), per channel,
+/// with the incidence parameter used.
+fn physical_plate(
+    q: &PlateQuery,
+    spectrum: &Spectrum,
+    towards: Vector3<f64>,
+    want: Want,
+) -> Result<Vec<(SlabMueller, C64)>> {
+    let (q, w, mirrored) = if towards.z > 0.0 {
+        (*q, towards, false)
+    } else {
+        (
+            q.flipped(),
+            Vector3::new(towards.x, towards.y, -towards.z),
+            true,
+        )
+    };
+    let frame = PlaneFrame::from_direction(w);
+    let beta = q.plate.ext * (w.x * w.x + w.y * w.y).sqrt();
+    let one = |band: &[Gaussian]| integrate(&q.plate, &frame, beta, band, want, q.output);
+    let ms: Vec<SlabMueller> = match *spectrum {
+        Spectrum::Band {
+            wavelength_nm,
+            fwhm_nm,
+        } => {
+            if !(fwhm_nm.is_finite() && fwhm_nm >= 0.0) {
+                return Err(Error::new(
+                    "filter_bandwidth",
+                    format!("must be >= 0, got {fwhm_nm}"),
+                ));
+            }
+            if fwhm_nm == 0.0 {
+                vec![q
+                    .plate
+                    .at(wavelength_nm)?
+                    .optics(&frame, beta)?
+                    .mueller(wavelength_nm, want)?]
+            } else {
+                vec![one(&[narrow_band(wavelength_nm, fwhm_nm)])?]
+            }
+        }
+        Spectrum::Weights(set) => (0..3)
+            .map(|c| one(gaussians(set, c)))
+            .collect::<Result<_>>()?,
+    };
+    let d = Matrix4::from_diagonal(&nalgebra::Vector4::new(1.0, 1.0, -1.0, -1.0));
+    let fix = |m: Option<Matrix4<f64>>| m.map(|m| if mirrored { d * m * d } else { m });
+    Ok(ms
+        .into_iter()
+        .map(|m| {
+            (
+                SlabMueller {
+                    r: fix(m.r),
+                    t: fix(m.t),
+                },
+                beta,
+            )
+        })
+        .collect())
+}

@@ -1,0 +1,386 @@
+//! Closed-form spectral integration of the plate's Mueller matrices (physics notes §4).
+//!
+//! A spectral weight `w(k)` (camera channel × illuminant, or a narrow band around one sampled
+//! wavelength) is a sum of Gaussians in wavenumber `k = 2π/λ`. Each Mueller matrix is a double
+//! sum over path classes `c, c'` of `cross(A_c, A_c') exp(i k d (Q_c' − Q̄_c))`; linearising the
+//! phase around the Gaussian's centre `μ` (phase path difference for the oscillation, group path
+//! difference `d/dk (k Q)` for the decay) each pair integrates in closed form:
+//!
+//! ```text
+//! ∫ G(k; μ, σ) exp(i k d ΔQ(k)) dk ≈ exp(i μ d ΔQ(μ) − σ² Φ₁² / (2 (1 − i Φ₂ σ²))) / √(1 − i Φ₂ σ²)
+//! Φ₁ = d Δ(Q + μ Q')   (group path difference),   Φ₂ = d Δ(2 Q' + μ Q'')   (its dispersion)
+//! ```
+//! which is exact for a phase quadratic in `k` (`Φ₂ = 0` without dispersion gives the plain
+//! Gaussian decay of the notes). Absorption enters `Φ₁` as its imaginary part (exact for an
+//! attenuation `exp(−k d Im ΔQ)` linear in `k`); Fresnel amplitudes are evaluated at `μ` (they
+//! vary slowly). Orders beyond `N` are the
+//! incoherent closed-form tail of [`crate::paths`]. Pairs whose group path difference is far
+//! beyond the coherence length `1/σ` are skipped (their factor is below `e^{-40}`).
+
+use crate::cmath;
+use crate::error::{Error, Result};
+use crate::frame::PlaneFrame;
+use crate::mueller;
+use crate::paths::{PathClass, PathExpansion};
+use crate::slab::{SlabMueller, SlabOptics, Want};
+use crate::spectral::hermite;
+use crate::spectral::plate::Plate;
+use crate::spectral::weights::Gaussian;
+use nalgebra::{Matrix2, Matrix4};
+use num_complex::Complex64 as C64;
+
+/// Highest coherent order ever used; the incoherent tail takes the rest.
+pub const MAX_ORDER: usize = 12;
+/// Orders are added until the round-trip amplitude falls below this.
+pub const ORDER_TOLERANCE: f64 = 1e-5;
+/// Pairs of classes whose amplitude product is below this contribute nothing visible.
+const PAIR_NEGLIGIBLE: f64 = 1e-12;
+
+/// Coherent order used for plates thicker than the coherence length.
+pub const THICK_ORDER: usize = 2;
+/// Pairs with `σ d |ΔG| > PAIR_CUTOFF` are incoherent (factor < e^{-40.5}).
+pub const PAIR_CUTOFF: f64 = 9.0;
+
+/// A unit-mass Gaussian band of full width at half maximum `fwhm_nm` (in wavelength) around
+/// `center_nm`, expressed in wavenumber.
+pub fn narrow_band(center_nm: f64, fwhm_nm: f64) -> Gaussian {
+    let mu = std::f64::consts::TAU / center_nm;
+    let sigma_nm = fwhm_nm / (8.0 * std::f64::consts::LN_2).sqrt();
+    Gaussian {
+        amplitude: 1.0,
+        mu,
+        sigma: mu * sigma_nm / center_nm,
+    }
+}
+
+/// What one band integration returns: Mueller matrices, or only their `M00` when no
+/// polarisation is asked for.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Output {
+    /// Full Mueller matrices.
+    Mueller,
+    /// Intensity only (`M00`, stored in entry (0,0)).
+    Intensity,
+}
+
+/// How the Gaussians of a band are integrated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Method {
+    /// Chosen per Gaussian from the plate's round-trip path difference `D`, the number of
+    /// significant round trips and the coherence length `1/σ` (see [`auto`]): Gauss–Hermite
+    /// quadrature of the exact plate when the integrand oscillates slowly over the band, the
+    /// closed-form path-class sum otherwise.
+    Auto,
+    /// Path classes up to the given coherent order (`None`: chosen automatically).
+    Paths(Option<usize>),
+    /// Gauss–Hermite quadrature of the exact plate with this many nodes.
+    Hermite(usize),
+    /// Composite Gauss–Legendre quadrature of the exact plate with this many 8-node panels
+    /// over ±6.5σ (many strongly interfering orders, e.g. near grazing incidence).
+    Panels(usize),
+}
+
+/// Largest oscillation (radians per band width) [`Method::Auto`] integrates by Gauss–Hermite.
+pub const HERMITE_LIMIT: f64 = 10.0;
+
+/// Integrates the plate's reflection/transmission Mueller matrices over the band
+/// `Σ_j a_j G(k; μ_j, σ_j)` (Mitsuba's convention, s/p frames, power fractions).
+pub fn integrate(
+    plate: &Plate,
+    frame: &PlaneFrame,
+    beta: C64,
+    band: &[Gaussian],
+    want: Want,
+    output: Output,
+) -> Result<SlabMueller> {
+    integrate_with(plate, frame, beta, band, want, output, Method::Auto)
+}
+
+/// [`integrate`] with a forced [`Method`] (for tests of the shortcuts and benchmarks).
+pub fn integrate_with(
+    plate: &Plate,
+    frame: &PlaneFrame,
+    beta: C64,
+    band: &[Gaussian],
+    want: Want,
+    output: Output,
+    method: Method,
+) -> Result<SlabMueller> {
+    if band.is_empty() {
+        return Err(Error::new("spectrum", "empty spectral band"));
+    }
+    let mut r = Matrix4::zeros();
+    let mut t = Matrix4::zeros();
+    // Without dispersion the interfaces do not depend on the wavelength: solve them once.
+    let fixed = if plate.is_dispersive() {
+        None
+    } else {
+        Some(
+            plate
+                .at(std::f64::consts::TAU / band[0].mu)?
+                .optics(frame, beta)?,
+        )
+    };
+    let optics_at = |lambda: f64| -> Result<SlabOptics> {
+        match fixed {
+            Some(o) => Ok(o),
+            None => plate.at(lambda)?.optics(frame, beta),
+        }
+    };
+    for g in band {
+        let lambda = std::f64::consts::TAU / g.mu;
+        let optics = optics_at(lambda)?;
+        let method = match method {
+            Method::Auto => auto(&optics, lambda, g.sigma),
+            m => m,
+        };
+        let (mr, mt) = match method {
+            Method::Hermite(n) => quadrature_rule(&optics_at, g, hermite::rule(n), want)?,
+            Method::Panels(p) => {
+                quadrature_rule(&optics_at, g, &hermite::composite_normal(p), want)?
+            }
+            _ => {
+                let order = match method {
+                    Method::Paths(Some(n)) => n,
+                    _ => coherent_order(&optics, lambda, g.sigma),
+                };
+                let paths = PathExpansion::new(&optics, order, lambda, want);
+                let group = dispersion(plate, frame, beta, g.mu)?;
+                let sum = |classes: &[PathClass], tail: &Matrix4<f64>| {
+                    band_sum(classes, &paths, g, &group, output) + tail
+                };
+                (
+                    sum(&paths.reflection, &paths.tail.r),
+                    sum(&paths.transmission, &paths.tail.t),
+                )
+            }
+        };
+        r += mr * g.amplitude;
+        t += mt * g.amplitude;
+    }
+    let keep = |m: Matrix4<f64>| match output {
+        Output::Mueller => m,
+        Output::Intensity => Matrix4::from_fn(|i, j| if i + j == 0 { m[(0, 0)] } else { 0.0 }),
+    };
+    Ok(SlabMueller {
+        r: want.reflection.then(|| keep(r)),
+        t: want.transmission.then(|| keep(t)),
+    })
+}
+
+/// The smallest round-trip phase index `min Re(q↑ − q↓)` of the layer (its group path per
+/// unit thickness for one internal round trip, up to dispersion).
+fn round_trip(optics: &SlabOptics) -> f64 {
+    let m = optics.layer_modes();
+    (0..2)
+        .flat_map(|a| (0..2).map(move |b| (m.up[a].q - m.down[b].q).re))
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// [`Method::Auto`]'s choice for one Gaussian. With `a = σ D` per round trip and `N` the
+/// number of round trips whose amplitude exceeds [`ORDER_TOLERANCE`], the integrand oscillates
+/// up to `a (N + 1)` radians per band width: Gauss–Hermite with `8 + 3x + x²` nodes integrates
+/// `exp(i x X)` to ~1e-6 up to `x = `[`HERMITE_LIMIT`] (128 nodes); beyond, the closed-form path
+/// classes take over (validated against dense quadrature in `tests/spectral_band.rs`).
+fn auto(optics: &SlabOptics, lambda: f64, sigma: f64) -> Method {
+    let a = sigma * optics.thickness_nm * round_trip(optics);
+    let n = amplitude_order(optics, lambda, MAX_PANEL_ORDER);
+    let x = a * (n as f64 + 1.0);
+    if x <= HERMITE_LIMIT {
+        Method::Hermite(((8.0 + 3.0 * x + x * x).ceil() as usize).min(hermite::MAX_NODES))
+    } else if a > PAIR_CUTOFF || n <= MAX_ORDER {
+        // Orders mutually incoherent, or few enough for the coherent path sum.
+        Method::Paths(None)
+    } else {
+        // Many strongly reflected orders inside the coherence length (grazing incidence):
+        // ~2 panels per oscillation of the highest significant order over ±6.5σ.
+        Method::Panels((((13.0 * x / std::f64::consts::TAU) * 2.0).ceil() as usize).max(16))
+    }
+}
+
+/// Highest order considered when choosing [`Method::Panels`].
+const MAX_PANEL_ORDER: usize = 2000;
+
+/// Round trips until the internal amplitude falls below [`ORDER_TOLERANCE`] (at most `cap`).
+fn amplitude_order(optics: &SlabOptics, lambda: f64, cap: usize) -> usize {
+    let (pd, pu) = optics.propagation(lambda);
+    let rho = (optics.top.r_below() * pu * optics.bottom.r_above() * pd).norm();
+    if rho <= 0.0 {
+        0
+    } else if rho >= 1.0 {
+        cap
+    } else {
+        ((ORDER_TOLERANCE.ln() / rho.ln()).ceil() as usize)
+            .saturating_sub(1)
+            .min(cap)
+    }
+}
+
+/// `Σ_i w_i M(μ + σ x_i)`: a quadrature rule for the normal law applied to the exact plate
+/// over one Gaussian. A convex combination of exact Mueller matrices, so energy is conserved
+/// exactly.
+fn quadrature_rule(
+    optics_at: &dyn Fn(f64) -> Result<SlabOptics>,
+    g: &Gaussian,
+    rule: &[(f64, f64)],
+    want: Want,
+) -> Result<(Matrix4<f64>, Matrix4<f64>)> {
+    let (mut r, mut t) = (Matrix4::zeros(), Matrix4::zeros());
+    for &(x, w) in rule {
+        let k = g.mu + g.sigma * x;
+        if k <= 0.0 {
+            continue;
+        }
+        let lambda = std::f64::consts::TAU / k;
+        let m = optics_at(lambda)?.mueller(lambda, want)?;
+        r += m.r.unwrap_or_default() * w;
+        t += m.t.unwrap_or_default() * w;
+    }
+    Ok((r, t))
+}
+
+/// First and second derivatives in `k` of the phase-per-traversal `Q` of the layer's four modes
+/// `[o↓, e↓, o↑, e↑]` at wavenumber `mu` (zero without dispersion), by central differences of
+/// the exact modes (step `10⁻³ μ`: truncation ~10⁻⁶, rounding ~10⁻¹⁰ relative).
+fn dispersion(plate: &Plate, frame: &PlaneFrame, beta: C64, mu: f64) -> Result<Dispersion> {
+    if !plate.is_dispersive() {
+        return Ok(Dispersion::default());
+    }
+    let h = mu * 1e-3;
+    let q = |k: f64| -> Result<[C64; 4]> {
+        let m = plate
+            .at(std::f64::consts::TAU / k)?
+            .layer_modes(frame, beta);
+        Ok([-m.down[0].q, -m.down[1].q, m.up[0].q, m.up[1].q])
+    };
+    let (a, b, c) = (q(mu + h)?, q(mu)?, q(mu - h)?);
+    Ok(Dispersion {
+        d1: std::array::from_fn(|i| ((a[i] - c[i]) / (2.0 * h)).re),
+        d2: std::array::from_fn(|i| ((a[i] - b[i] * 2.0 + c[i]) / (h * h)).re),
+    })
+}
+
+/// `dQ/dk` and `d²Q/dk²` per mode (see [`dispersion`]).
+#[derive(Clone, Copy, Debug, Default)]
+struct Dispersion {
+    d1: [f64; 4],
+    d2: [f64; 4],
+}
+
+/// The coherent order `N` of the path-class method: enough round trips for the amplitude to
+/// fall below [`ORDER_TOLERANCE`]; at most [`THICK_ORDER`] if a round trip is longer than the
+/// coherence length (then orders only interfere with paths of the same traversal counts,
+/// which the incoherent tail would miss only at the first orders, where mode conversions
+/// still carry weight).
+fn coherent_order(optics: &SlabOptics, lambda: f64, sigma: f64) -> usize {
+    let cap = if sigma * optics.thickness_nm * round_trip(optics) > PAIR_CUTOFF {
+        THICK_ORDER
+    } else {
+        MAX_ORDER
+    };
+    amplitude_order(optics, lambda, MAX_ORDER).min(cap)
+}
+
+/// `Σ_{c,c'} F_cc' cross(A_c, A_c')` as a Mueller matrix, `F` the closed-form Gaussian
+/// integral of the pair's phase.
+fn band_sum(
+    classes: &[PathClass],
+    paths: &PathExpansion,
+    g: &Gaussian,
+    disp: &Dispersion,
+    output: Output,
+) -> Matrix4<f64> {
+    let d = paths.thickness_nm;
+    let sum = |c: &PathClass, x: &[f64; 4]| -> f64 {
+        c.counts.iter().zip(x).map(|(n, x)| x * f64::from(*n)).sum()
+    };
+    // Per class: group term Q + μ Q' and curvature term 2 Q' + μ Q''.
+    let gs: Vec<(f64, f64)> = classes
+        .iter()
+        .map(|c| {
+            let (d1, d2) = (sum(c, &disp.d1), sum(c, &disp.d2));
+            (c.q.re + g.mu * d1, 2.0 * d1 + g.mu * d2)
+        })
+        .collect();
+    let s2 = g.sigma * g.sigma;
+    let i = C64::new(0.0, 1.0);
+    let mut k = Matrix4::<C64>::zeros();
+    let mut m00 = 0.0;
+    let norms: Vec<f64> = classes.iter().map(|c| c.amplitude.norm()).collect();
+    for (a, ca) in classes.iter().enumerate() {
+        let mut b = Matrix2::<C64>::zeros();
+        for (c, cc) in classes.iter().enumerate() {
+            let re1 = d * (gs[c].0 - gs[a].0);
+            if g.sigma * re1.abs() > PAIR_CUTOFF || norms[a] * norms[c] < PAIR_NEGLIGIBLE {
+                continue;
+            }
+            // Absorption makes the exponent complex; the integral stays exact for an
+            // attenuation linear in k, as long as it does not move the band's centre by more
+            // than a band width (beyond, the Gaussian model of the band no longer holds and the
+            // term is attenuated to ~e^{-μ/σ} anyway).
+            let im1 = (d * (cc.q.im + ca.q.im)).min(1.0 / g.sigma);
+            let phi1 = C64::new(re1, im1);
+            let phi2 = d * (gs[c].1 - gs[a].1);
+            let den = C64::new(1.0, -phi2 * s2);
+            let phase = i * g.mu * d * (cc.q - ca.q.conj());
+            b += cc.amplitude * (phase - 0.5 * s2 * phi1 * phi1 / den).exp() / cmath::sqrt(den);
+        }
+        match output {
+            Output::Mueller => k += mueller::cross(&ca.amplitude, &b),
+            Output::Intensity => {
+                m00 += 0.5 * ca.amplitude.zip_map(&b, |x, y| x.conj() * y).sum().re
+            }
+        }
+    }
+    match output {
+        Output::Mueller => mueller::from_coherency(&k),
+        Output::Intensity => {
+            let mut m = Matrix4::zeros();
+            m[(0, 0)] = m00;
+            m
+        }
+    }
+}
+
+/// Reference: `∫ w(λ) M(λ) dλ` of the exact slab by the trapezoid rule on `[lo, hi]` with
+/// `step_nm`, `weight` per nm (normalise it yourself). Slow; for validation.
+pub fn quadrature(
+    plate: &Plate,
+    frame: &PlaneFrame,
+    beta: C64,
+    weight: impl Fn(f64) -> f64,
+    (lo, hi): (f64, f64),
+    step_nm: f64,
+    want: Want,
+) -> Result<SlabMueller> {
+    if !(step_nm > 0.0 && step_nm.is_finite()) {
+        return Err(Error::new("step_nm", "must be > 0"));
+    }
+    let n = ((hi - lo) / step_nm).ceil().max(1.0) as usize;
+    let h = (hi - lo) / n as f64;
+    let fixed = if plate.is_dispersive() {
+        None
+    } else {
+        Some(plate.at(0.5 * (lo + hi))?.optics(frame, beta)?)
+    };
+    let mut r = Matrix4::zeros();
+    let mut t = Matrix4::zeros();
+    for j in 0..=n {
+        let lambda = lo + h * j as f64;
+        let w = weight(lambda) * if j == 0 || j == n { 0.5 * h } else { h };
+        if w == 0.0 {
+            continue;
+        }
+        let optics = match fixed {
+            Some(o) => o,
+            None => plate.at(lambda)?.optics(frame, beta)?,
+        };
+        let m = optics.mueller(lambda, want)?;
+        r += m.r.unwrap_or_default() * w;
+        t += m.t.unwrap_or_default() * w;
+    }
+    Ok(SlabMueller {
+        r: want.reflection.then_some(r),
+        t: want.transmission.then_some(t),
+    })
+}
