@@ -1,7 +1,9 @@
 # mitsuba-birefringent — build, render and test entry points.
 #
-#   make render   the main job: builds everything (make setup), then makes out/fig1.png
-#                 and out/fig1.json (Figure 1 of the paper's supplemental)
+#   make render   the main job: builds everything (make setup), then renders the default scene
+#                 (a quartz wedge between crossed polarisers: the Michel-Levy interference
+#                 colours) to out/michel_levy.exr and .png, and Figure 1 of the paper's
+#                 supplemental to out/fig1.png and out/fig1.json
 #   make test     builds everything (make setup), then runs every test: cargo's, then pytest's
 #   make setup    cargo build --release, the virtualenv .venv/ from requirements.txt, the
 #                 Mitsuba plugin library (cpp/) and the mitsuba_birefringent package in .venv/;
@@ -105,10 +107,13 @@ $(RUST_LIB):
 
 ## ---- main job ---------------------------------------------------------------------------
 
-# Figure 1 of the supplemental: Fresnel power ratios of an isotropic/uniaxial interface,
-# computed by the calculator binary. Always regenerated (a few seconds).
+# The default scene (scenes/michel_levy.py, scalar_spectral_polarized, about a minute on 2 cores)
+# and Figure 1 of the supplemental (Fresnel power ratios of an isotropic/uniaxial interface,
+# computed by the calculator binary, a few seconds). Always regenerated.
+RENDER_SPP ?= 16
 render: setup
 	@mkdir -p $(OUT)
+	$(VPY) scenes/render.py michel_levy --out $(OUT) --spp $(RENDER_SPP) --width 256 --height 96
 	$(VPY) tools/plot_fig1.py $(BIN) $(OUT)
 
 ## ---- tests ------------------------------------------------------------------------------
