@@ -15,7 +15,7 @@
 //! attenuation `exp(−k d Im ΔQ)` linear in `k`); Fresnel amplitudes are evaluated at `μ` (they
 //! vary slowly). Orders beyond `N` are the
 //! incoherent closed-form tail of [`crate::paths`]. Pairs whose group path difference is far
-//! beyond the coherence length `1/σ` are skipped (their factor is below `e^{-40}`).
+//! beyond the coherence length `1/σ` are skipped (their factor is below `e^{-18}`).
 
 use crate::cmath;
 use crate::error::{Error, Result};
@@ -38,8 +38,8 @@ const PAIR_NEGLIGIBLE: f64 = 1e-12;
 
 /// Coherent order used for plates thicker than the coherence length.
 pub const THICK_ORDER: usize = 2;
-/// Pairs with `σ d |ΔG| > PAIR_CUTOFF` are incoherent (factor < e^{-40.5}).
-pub const PAIR_CUTOFF: f64 = 9.0;
+/// Pairs with `σ d |ΔG| > PAIR_CUTOFF` are incoherent (factor < e^{-18} ≈ 1.5e-8).
+pub const PAIR_CUTOFF: f64 = 6.0;
 
 /// A unit-mass Gaussian band of full width at half maximum `fwhm_nm` (in wavelength) around
 /// `center_nm`, expressed in wavenumber.
