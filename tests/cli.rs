@@ -140,3 +140,104 @@ fn inside_incidence_and_named_materials() {
             .sum::<f64>();
     assert!((total - 1.0).abs() < 1e-12);
 }
+
+const PLATE: &str = r#""wavelength_nm": 550, "material": "quartz", "optic_axis": [0.7, 0.7, 0.1], "theta_deg": 20, "phi_deg": 30, "thickness_um": 12"#;
+
+fn slab(extra: &str) -> (i32, Value) {
+    let (code, out) = run(&["slab"], &format!("{{{PLATE}{extra}}}"));
+    (code, serde_json::from_str(&out).unwrap())
+}
+
+#[test]
+fn slab_monochromatic_conserves_energy_and_prints_jones_and_mueller() {
+    let (code, v) = slab("");
+    assert_eq!(code, 0, "{v}");
+    for input in ["s", "p"] {
+        let total: f64 = ["s", "p"]
+            .iter()
+            .map(|o| {
+                v["R"][format!("{input}{o}")].as_f64().unwrap()
+                    + v["T"][format!("{input}{o}")].as_f64().unwrap()
+            })
+            .sum();
+        assert!((total - 1.0).abs() < 1e-12);
+    }
+    assert_eq!(v["mueller"]["T"].as_array().unwrap().len(), 4);
+    assert_eq!(v["jones"]["R"].as_array().unwrap().len(), 2);
+    // A zero band is the monochromatic plate.
+    let (_, b) = slab(r#", "spectrum": {"bandwidth_nm": 0}"#);
+    assert_eq!(b["mueller_T"], v["mueller"]["T"]);
+}
+
+#[test]
+fn slab_spectrum_analytic_agrees_with_quadrature() {
+    for spectrum in [r#"{"weights": "xyz-d65"}"#, r#"{"bandwidth_nm": 12}"#] {
+        let (_, a) = slab(&format!(r#", "spectrum": {spectrum}"#));
+        let q_spec = spectrum.replace('}', r#", "method": "quadrature", "step_nm": 0.05}"#);
+        let (code, q) = slab(&format!(r#", "spectrum": {q_spec}"#));
+        assert_eq!(code, 0, "{q}");
+        let flat = |v: &Value| -> Vec<f64> {
+            let mut out = Vec::new();
+            fn walk(v: &Value, out: &mut Vec<f64>) {
+                match v {
+                    Value::Number(n) => out.push(n.as_f64().unwrap()),
+                    Value::Array(a) => a.iter().for_each(|x| walk(x, out)),
+                    _ => {}
+                }
+            }
+            walk(&v["mueller_T"], &mut out);
+            walk(&v["mueller_R"], &mut out);
+            out
+        };
+        let (fa, fq) = (flat(&a), flat(&q));
+        assert_eq!(fa.len(), fq.len());
+        let worst = fa
+            .iter()
+            .zip(&fq)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f64::max);
+        // Gaussian fits of the CIE weights (~1e-3 in the Fourier domain) vs the 1-nm tables.
+        assert!(worst < 3e-3, "{spectrum}: {worst}");
+        if spectrum.contains("weights") {
+            assert_eq!(a["channels"], serde_json::json!(["X", "Y", "Z"]));
+            assert_eq!(a["T"]["ss"].as_array().unwrap().len(), 3);
+        }
+    }
+}
+
+#[test]
+fn slab_errors_name_the_field() {
+    let cases = [
+        (
+            r#", "spectrum": {"weights": "srgb", "bandwidth_nm": 3}"#,
+            "spectrum",
+        ),
+        (r#", "spectrum": {"weights": "rgb"}"#, "spectrum.weights"),
+        (
+            r#", "spectrum": {"bandwidth_nm": 3, "step": 1}"#,
+            "spectrum.step",
+        ),
+        (
+            r#", "spectrum": {"bandwidth_nm": -3}"#,
+            "spectrum.bandwidth_nm",
+        ),
+        (
+            r#", "spectrum": {"weights": "xyz-e", "method": "monte-carlo"}"#,
+            "spectrum.method",
+        ),
+        (r#", "exit_ior": -1"#, "exit_ior"),
+        (r#", "side": "inside""#, "side"),
+    ];
+    for (extra, field) in cases {
+        let (code, v) = slab(extra);
+        assert_eq!(code, 1, "{extra}");
+        let msg = v["error"].as_str().unwrap();
+        assert!(msg.starts_with(&format!("{field}:")), "{extra} -> {msg}");
+    }
+    let (code, out) = run(
+        &["slab"],
+        r#"{"wavelength_nm": 550, "eta_o": 1.5, "eta_e": 1.6, "optic_axis": [1,0,0], "theta_deg": 0, "thickness_um": -2}"#,
+    );
+    assert_eq!(code, 1);
+    assert!(out.contains("thickness_um"), "{out}");
+}
