@@ -9,25 +9,8 @@ use birefringent::surface::{Incident, Surface};
 use birefringent::C64;
 use nalgebra::{Matrix4, Vector3, Vector4};
 
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E3779B97F4A7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58476D1CE4E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D049BB133111EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn range(&mut self, a: f64, b: f64) -> f64 {
-        a + (b - a) * self.next()
-    }
-    fn direction(&mut self) -> Vector3<f64> {
-        let z = self.range(-1.0, 1.0);
-        let p = self.range(0.0, std::f64::consts::TAU);
-        let r = (1.0 - z * z).sqrt();
-        Vector3::new(r * p.cos(), r * p.sin(), z)
-    }
-}
+mod common;
+use common::Rng;
 
 fn lobes(e: &Event) -> impl Iterator<Item = &Lobe> {
     e.reflected.iter().chain(e.transmitted.iter()).flatten()
@@ -39,7 +22,7 @@ fn total_power(e: &Event, stokes_in: Vector4<f64>) -> f64 {
 
 #[test]
 fn lobes_conserve_energy_for_every_polarisation_and_frames_are_transverse() {
-    let mut rng = Rng(11);
+    let mut rng = Rng::new(11);
     let states = [
         Vector4::new(1.0, 0.0, 0.0, 0.0),
         Vector4::new(1.0, 1.0, 0.0, 0.0),
@@ -52,11 +35,11 @@ fn lobes_conserve_energy_for_every_polarisation_and_frames_are_transverse() {
         let crystal = Uniaxial::new(
             C64::new(rng.range(1.3, 2.7), 0.0),
             C64::new(rng.range(1.3, 2.7), 0.0),
-            rng.direction(),
+            rng.unit_vector(),
         )
         .unwrap();
         let s = Surface::new(C64::new(rng.range(1.0, 1.6), 0.0), crystal).unwrap();
-        let mut w = rng.direction();
+        let mut w = rng.unit_vector();
         let incident = match case % 3 {
             0 => Incident::Outside,
             1 => Incident::Inside(ModeKind::O),

@@ -9,25 +9,8 @@ use birefringent::slab::{Slab, Want};
 use birefringent::C64;
 use nalgebra::{Matrix2, Vector3};
 
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E3779B97F4A7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58476D1CE4E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D049BB133111EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn range(&mut self, a: f64, b: f64) -> f64 {
-        a + (b - a) * self.next()
-    }
-    fn direction(&mut self) -> Vector3<f64> {
-        let z = self.range(-1.0, 1.0);
-        let p = self.range(0.0, std::f64::consts::TAU);
-        let r = (1.0 - z * z).sqrt();
-        Vector3::new(r * p.cos(), r * p.sin(), z)
-    }
-}
+mod common;
+use common::Rng;
 
 fn re(x: f64) -> C64 {
     C64::new(x, 0.0)
@@ -103,13 +86,13 @@ fn isotropic_layer_is_the_airy_etalon() {
 
 #[test]
 fn lossless_slabs_conserve_energy() {
-    let mut rng = Rng(21);
+    let mut rng = Rng::new(21);
     let mut worst = 0.0f64;
     for _ in 0..5_000 {
         let layer = Uniaxial::new(
             re(rng.range(1.3, 2.7)),
             re(rng.range(1.3, 2.7)),
-            rng.direction(),
+            rng.unit_vector(),
         )
         .unwrap();
         let (n1, n3) = (rng.range(1.0, 1.6), rng.range(1.0, 1.6));
@@ -243,7 +226,7 @@ fn thick_isotropic_plate_incoherent_limit_is_the_thindielectric_series() {
 
 #[test]
 fn path_expansion_to_high_order_equals_the_exact_slab() {
-    let mut rng = Rng(23);
+    let mut rng = Rng::new(23);
     let mut worst = 0.0f64;
     for case in 0..300 {
         let layer = Uniaxial::new(
@@ -256,7 +239,7 @@ fn path_expansion_to_high_order_equals_the_exact_slab() {
                 },
             ),
             re(rng.range(1.3, 2.7)),
-            rng.direction(),
+            rng.unit_vector(),
         )
         .unwrap();
         let slab = Slab::new(
