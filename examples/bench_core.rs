@@ -39,9 +39,9 @@ use birefringent::interface::Interface;
 use birefringent::material::Material;
 use birefringent::medium::Uniaxial;
 use birefringent::slab::{Slab, SlabOptics, Want};
-use birefringent::spectral::integrate::{integrate, Output};
+use birefringent::spectral::integrate::{integrate_set, Output};
 use birefringent::spectral::plate::Plate;
-use birefringent::spectral::weights::{gaussians, weight_per_nm};
+use birefringent::spectral::weights::weight_per_nm;
 use birefringent::C64;
 use serde_json::{json, Value};
 use spectral_rgb::{Case, Outcome, Rng, QUANTITIES, RANGE, SET};
@@ -460,21 +460,19 @@ fn stochastic(case: &Case, sampler: &Sampler, n: usize, rng: &mut Rng, hero: boo
     xyz.map(|x| x / n as f64)
 }
 
-/// Closed form for the crossed-polariser colour (transmission only, or both lobes).
+/// Closed form for the crossed-polariser colour (transmission only, or both lobes): all three
+/// channels through `integrate_set`.
 fn analytic_crossed(case: &Case, want: Want) -> [f64; 3] {
-    let (frame, beta) = (case.frame(), case.beta());
-    std::array::from_fn(|c| {
-        let m = integrate(
-            &case.plate,
-            &frame,
-            beta,
-            gaussians(SET, c),
-            want,
-            Output::Mueller,
-        )
-        .unwrap();
-        spectral_rgb::crossed(&m.t.unwrap())
-    })
+    let ms = integrate_set(
+        &case.plate,
+        &case.frame(),
+        case.beta(),
+        SET,
+        want,
+        Output::Mueller,
+    )
+    .unwrap();
+    std::array::from_fn(|c| spectral_rgb::crossed(&ms[c].t.unwrap()))
 }
 
 fn mean(v: &[f64]) -> f64 {

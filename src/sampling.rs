@@ -16,9 +16,9 @@ use crate::material::Material;
 use crate::medium::{check_clear_index, Uniaxial};
 use crate::modes::ModeKind;
 use crate::slab::{SlabMueller, Want};
-use crate::spectral::integrate::{integrate, narrow_band, Output};
+use crate::spectral::integrate::{integrate, integrate_set, narrow_band, Output};
 use crate::spectral::plate::Plate;
-use crate::spectral::weights::{gaussians, Gaussian, WeightSet};
+use crate::spectral::weights::{Gaussian, WeightSet};
 use crate::surface::{Incident, Surface};
 use nalgebra::{Matrix4, Vector3};
 use num_complex::Complex64 as C64;
@@ -381,9 +381,9 @@ fn physical_plate(
                 vec![one(&[narrow_band(wavelength_nm, fwhm_nm)])?]
             }
         }
-        Spectrum::Weights(set) => (0..3)
-            .map(|c| one(gaussians(set, c)))
-            .collect::<Result<_>>()?,
+        Spectrum::Weights(set) => {
+            integrate_set(&q.plate, &frame, beta, set, want, q.output)?.to_vec()
+        }
     };
     let d = Matrix4::from_diagonal(&nalgebra::Vector4::new(1.0, 1.0, -1.0, -1.0));
     let fix = |m: Option<Matrix4<f64>>| m.map(|m| if mirrored { d * m * d } else { m });

@@ -32,7 +32,7 @@
 use birefringent::frame::PlaneFrame;
 use birefringent::material::{Index, Material};
 use birefringent::slab::{SlabMueller, Want};
-use birefringent::spectral::integrate::{integrate, Output};
+use birefringent::spectral::integrate::{integrate_set, Output};
 use birefringent::spectral::plate::Plate;
 use birefringent::spectral::weights::{ciede2000, gaussians, weight_per_nm, xyz_to_lab, WeightSet};
 use birefringent::C64;
@@ -261,21 +261,21 @@ pub fn crossed(t: &nalgebra::Matrix4<f64>) -> f64 {
 /// XYZ per quantity: `xyz[q][c]`.
 pub type Colours = [[f64; 3]; 3];
 
-/// The closed-form integration: one `integrate` call per channel (both lobes, full Mueller).
+/// The closed-form integration of all three channels (`integrate_set`; both lobes, full
+/// Mueller).
 pub fn analytic(case: &Case) -> Colours {
     let mut out = [[0.0; 3]; 3];
-    #[allow(clippy::needless_range_loop)]
-    for c in 0..3 {
-        let m = integrate(
-            &case.plate,
-            &case.frame(),
-            case.beta(),
-            gaussians(SET, c),
-            Want::BOTH,
-            Output::Mueller,
-        )
-        .unwrap_or_else(|e| panic!("integrate failed for {}: {e:?}", case.describe()));
-        for (q, v) in quantities(&m).into_iter().enumerate() {
+    let ms = integrate_set(
+        &case.plate,
+        &case.frame(),
+        case.beta(),
+        SET,
+        Want::BOTH,
+        Output::Mueller,
+    )
+    .unwrap_or_else(|e| panic!("integrate failed for {}: {e:?}", case.describe()));
+    for (c, m) in ms.iter().enumerate() {
+        for (q, v) in quantities(m).into_iter().enumerate() {
             out[q][c] = v;
         }
     }

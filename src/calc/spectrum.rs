@@ -7,8 +7,8 @@ use super::output::num;
 use super::slab::{matrix, read, SlabQuery};
 use crate::error::{Error, Result};
 use crate::slab::{SlabMueller, Want};
-use crate::spectral::integrate::{integrate, narrow_band, quadrature, Output};
-use crate::spectral::weights::{gaussians, weight_per_nm, WeightSet};
+use crate::spectral::integrate::{integrate, integrate_set, narrow_band, quadrature, Output};
+use crate::spectral::weights::{weight_per_nm, WeightSet};
 use nalgebra::{Matrix4, Vector4};
 use serde_json::{json, Map, Value};
 
@@ -55,9 +55,9 @@ pub fn run(input: &Value, fields: &[&str], spec: &Value) -> Result<Value> {
                     ));
                 }
                 let step = step.unwrap_or_else(|| auto_step(&q, RANGE.0));
-                let per_channel = (0..3)
-                    .map(|c| {
-                        if quad {
+                let per_channel = if quad {
+                    (0..3)
+                        .map(|c| {
                             quadrature(
                                 &q.plate,
                                 &q.frame,
@@ -67,18 +67,12 @@ pub fn run(input: &Value, fields: &[&str], spec: &Value) -> Result<Value> {
                                 step,
                                 Want::BOTH,
                             )
-                        } else {
-                            integrate(
-                                &q.plate,
-                                &q.frame,
-                                q.beta,
-                                gaussians(set, c),
-                                Want::BOTH,
-                                Output::Mueller,
-                            )
-                        }
-                    })
-                    .collect::<Result<Vec<_>>>()?;
+                        })
+                        .collect::<Result<Vec<_>>>()?
+                } else {
+                    integrate_set(&q.plate, &q.frame, q.beta, set, Want::BOTH, Output::Mueller)?
+                        .to_vec()
+                };
                 (
                     set.channel_names().iter().map(|s| s.to_string()).collect(),
                     per_channel,

@@ -39,6 +39,25 @@ pub fn composite_normal(panels: usize) -> Vec<(f64, f64)> {
     rule
 }
 
+/// Composite 8-point Gauss–Legendre nodes and weights on `[lo, hi]` with `panels` equal panels
+/// (`Σ w f(x) ≈ ∫ f`).
+pub fn composite_interval(lo: f64, hi: f64, panels: usize) -> Vec<(f64, f64)> {
+    let gl = legendre8();
+    let h = (hi - lo) / panels.max(1) as f64;
+    (0..panels.max(1))
+        .flat_map(|p| {
+            let c = lo + h * (p as f64 + 0.5);
+            gl.iter().map(move |&(x, w)| (c + 0.5 * h * x, 0.5 * h * w))
+        })
+        .collect()
+}
+
+/// The 8-point Gauss–Legendre rule on `[−1, 1]`.
+fn legendre8() -> &'static [(f64, f64)] {
+    static LEGENDRE: OnceLock<Vec<(f64, f64)>> = OnceLock::new();
+    LEGENDRE.get_or_init(|| jacobi_rule(8, |k| k as f64 / ((4 * k * k - 1) as f64).sqrt(), 2.0))
+}
+
 /// Golub–Welsch for a symmetric Jacobi matrix with zero diagonal and off-diagonal `b(k)`,
 /// `k = 1..n−1`, and total weight `mu0`.
 fn jacobi_rule(n: usize, b: impl Fn(usize) -> f64, mu0: f64) -> Vec<(f64, f64)> {

@@ -25,7 +25,7 @@ use crate::paths::{PathClass, PathExpansion};
 use crate::slab::{SlabMueller, SlabOptics, Want};
 use crate::spectral::hermite;
 use crate::spectral::plate::Plate;
-use crate::spectral::weights::Gaussian;
+use crate::spectral::weights::{gaussians, Gaussian, WeightSet};
 use nalgebra::{Matrix2, Matrix4};
 use num_complex::Complex64 as C64;
 
@@ -237,6 +237,77 @@ fn quadrature_rule(
         t += m.t.unwrap_or_default() * w;
     }
     Ok((r, t))
+}
+
+/// Largest number of plate evaluations [`integrate_set`] spends on one shared quadrature.
+pub const SHARED_NODES_MAX: usize = 512;
+
+/// Integrates over the three channels of a weight set at once (see [`integrate`]).
+///
+/// When the plate's spectrum varies slowly over the whole visible range (thin plates: few
+/// oscillations of its longest significant path difference across the weights' support), one
+/// composite Gauss–Legendre quadrature of the exact plate over that support serves every
+/// Gaussian of every channel: `∫ w_c(k) M(k) dk` with `w_c` the same fitted sum of Gaussians, at
+/// most [`SHARED_NODES_MAX`] plate evaluations instead of a quadrature per Gaussian. Otherwise
+/// each channel goes through [`integrate`].
+pub fn integrate_set(
+    plate: &Plate,
+    frame: &PlaneFrame,
+    beta: C64,
+    set: WeightSet,
+    want: Want,
+    output: Output,
+) -> Result<[SlabMueller; 3]> {
+    let bands: [&[Gaussian]; 3] = std::array::from_fn(|c| gaussians(set, c));
+    let all = bands.iter().flat_map(|b| b.iter());
+    let lo = all
+        .clone()
+        .map(|g| g.mu - 6.0 * g.sigma)
+        .fold(f64::INFINITY, f64::min)
+        .max(1e-6);
+    let hi = all.map(|g| g.mu + 6.0 * g.sigma).fold(0.0, f64::max);
+    let centre = std::f64::consts::TAU / (0.5 * (lo + hi));
+    let optics = plate.at(centre)?.optics(frame, beta)?;
+    let orders = amplitude_order(&optics, centre, MAX_PANEL_ORDER) as f64 + 1.0;
+    let oscillations =
+        optics.thickness_nm * round_trip(&optics) * orders * (hi - lo) / std::f64::consts::TAU;
+    let panels = ((2.0 * oscillations).ceil() as usize).max(8);
+    if panels * 8 > SHARED_NODES_MAX {
+        let one = |c: usize| integrate(plate, frame, beta, bands[c], want, output);
+        return Ok([one(0)?, one(1)?, one(2)?]);
+    }
+    let fixed = (!plate.is_dispersive()).then_some(optics);
+    let mut acc = [(Matrix4::zeros(), Matrix4::zeros()); 3];
+    for (k, w) in hermite::composite_interval(lo, hi, panels) {
+        let lambda = std::f64::consts::TAU / k;
+        let o = match fixed {
+            Some(o) => o,
+            None => plate.at(lambda)?.optics(frame, beta)?,
+        };
+        let m = o.mueller(lambda, want)?;
+        for (c, band) in bands.iter().enumerate() {
+            let wc = w * band
+                .iter()
+                .map(|g| g.amplitude * normal_pdf(k, g))
+                .sum::<f64>();
+            acc[c].0 += m.r.unwrap_or_default() * wc;
+            acc[c].1 += m.t.unwrap_or_default() * wc;
+        }
+    }
+    let keep = |m: Matrix4<f64>| match output {
+        Output::Mueller => m,
+        Output::Intensity => Matrix4::from_fn(|i, j| if i + j == 0 { m[(0, 0)] } else { 0.0 }),
+    };
+    Ok(acc.map(|(r, t)| SlabMueller {
+        r: want.reflection.then(|| keep(r)),
+        t: want.transmission.then(|| keep(t)),
+    }))
+}
+
+/// The unit-mass normal density `G(k; μ, σ)`.
+fn normal_pdf(k: f64, g: &Gaussian) -> f64 {
+    let z = (k - g.mu) / g.sigma;
+    (-0.5 * z * z).exp() / (g.sigma * std::f64::consts::TAU.sqrt())
 }
 
 /// First and second derivatives in `k` of the phase-per-traversal `Q` of the layer's four modes
