@@ -187,14 +187,21 @@ fn auto(optics: &SlabOptics, lambda: f64, sigma: f64) -> Method {
     let n = amplitude_order(optics, lambda, MAX_PANEL_ORDER);
     let x = a * (n as f64 + 1.0);
     if x <= HERMITE_LIMIT {
-        Method::Hermite(((8.0 + 3.0 * x + x * x).ceil() as usize).min(hermite::MAX_NODES))
-    } else if a > PAIR_CUTOFF || n <= MAX_ORDER {
-        // Orders mutually incoherent, or few enough for the coherent path sum.
+        return Method::Hermite(((8.0 + 3.0 * x + x * x).ceil() as usize).min(hermite::MAX_NODES));
+    }
+    if a > PAIR_CUTOFF {
+        // Orders mutually incoherent: a few coherent orders and the incoherent tail.
+        return Method::Paths(None);
+    }
+    // Many interfering orders: the coherent path sum (~K² pair terms for K ≈ (N+2)³/3 classes)
+    // or ~2 quadrature panels per oscillation of the highest significant order over ±6.5σ
+    // (8 exact plates each), whichever costs less (a pair term ~1/40 of a plate evaluation).
+    let panels = (((13.0 * x / std::f64::consts::TAU) * 2.0).ceil() as usize).max(16);
+    let classes = (n as f64 + 2.0).powi(3) / 3.0;
+    if n <= MAX_ORDER && classes * classes < 40.0 * 8.0 * panels as f64 {
         Method::Paths(None)
     } else {
-        // Many strongly reflected orders inside the coherence length (grazing incidence):
-        // ~2 panels per oscillation of the highest significant order over ±6.5σ.
-        Method::Panels((((13.0 * x / std::f64::consts::TAU) * 2.0).ceil() as usize).max(16))
+        Method::Panels(panels)
     }
 }
 
@@ -240,7 +247,7 @@ fn quadrature_rule(
 }
 
 /// Largest number of plate evaluations [`integrate_set`] spends on one shared quadrature.
-pub const SHARED_NODES_MAX: usize = 512;
+pub const SHARED_NODES_MAX: usize = 1024;
 
 /// Integrates over the three channels of a weight set at once (see [`integrate`]).
 ///
