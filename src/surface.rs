@@ -91,12 +91,4 @@ impl Solved {
     pub fn wave_local(&self, mode: &Mode) -> Vector3<f64> {
         self.frame.to_local(mode.wave_direction())
     }
-
-    /// The incoming mode of the scattering matrix for `incident` (column index, mode).
-    pub fn incoming(&self, incident: Incident, index: usize) -> (usize, Mode) {
-        match incident {
-            Incident::Outside => (index, self.interface.upper.down[index]),
-            Incident::Inside(_) => (2 + index, self.interface.lower.up[index]),
-        }
-    }
 }

@@ -2,7 +2,7 @@
 //! each wavelength it needs.
 
 use crate::error::Result;
-use crate::material::{Index, Material};
+use crate::material::Material;
 use crate::medium::Uniaxial;
 use crate::slab::Slab;
 use nalgebra::Vector3;
@@ -26,21 +26,6 @@ pub struct Plate {
 }
 
 impl Plate {
-    /// A plate with the constant indices of `slab`.
-    pub fn constant(slab: &Slab) -> Self {
-        Plate {
-            material: Material {
-                eta_o: Index::Constant(slab.layer.eta_o),
-                eta_e: Index::Constant(slab.layer.eta_e),
-            },
-            birefringence: 0.0,
-            ext: slab.top.eta_o,
-            exit: slab.bottom.eta_o,
-            axis: slab.layer.axis,
-            thickness_nm: slab.thickness_nm,
-        }
-    }
-
     /// The slab at `lambda_nm`.
     pub fn at(&self, lambda_nm: f64) -> Result<Slab> {
         let (eo, ee) = self.material.indices(lambda_nm, self.birefringence)?;
