@@ -614,7 +614,8 @@ fn stochastic_study(outcomes: &[Outcome], seeds: usize) -> Value {
     let quantile = |v: &[f64], q: f64| {
         let mut s = v.to_vec();
         s.sort_by(f64::total_cmp);
-        s[((q * s.len() as f64) as usize).min(s.len() - 1)]
+        // Nearest rank: the smallest value with at least a fraction q of the values <= it.
+        s[((q * s.len() as f64).ceil() as usize).clamp(1, s.len()) - 1]
     };
     let slowest = (0..cases.len())
         .max_by(|a, b| analytic_rt_pp[*a].total_cmp(&analytic_rt_pp[*b]))

@@ -1,7 +1,8 @@
 //! Colour accuracy of the closed-form spectral integration: for random plates, the XYZ colours
-//! (weights `xyz-d65`, Gaussian fits in wavenumber) computed by [`integrate`] against dense
-//! quadrature of the exact plate (a fresh `Slab` at every wavelength) with the tabulated 1-nm
-//! weights that the Gaussians were fitted to, compared by CIEDE2000.
+//! (weights `xyz-d65`, Gaussian fits in wavenumber) computed by [`integrate_set`] (all three
+//! channels at once) against dense quadrature of the exact plate (a fresh `Slab` at every
+//! wavelength) with the tabulated 1-nm weights that the Gaussians were fitted to, compared by
+//! CIEDE2000.
 //!
 //! Quantities (all power fractions, so XYZ is in a sensible range for Lab as it stands; the
 //! `xyz-d65` weights are normalised so that a spectrally flat 1 gives `(1, 1, 1)`, which is
@@ -273,7 +274,7 @@ pub fn analytic(case: &Case) -> Colours {
         Want::BOTH,
         Output::Mueller,
     )
-    .unwrap_or_else(|e| panic!("integrate failed for {}: {e:?}", case.describe()));
+    .unwrap_or_else(|e| panic!("integrate_set failed for {}: {e:?}", case.describe()));
     for (c, m) in ms.iter().enumerate() {
         for (q, v) in quantities(m).into_iter().enumerate() {
             out[q][c] = v;
