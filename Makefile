@@ -164,7 +164,7 @@ lint:
 clean:
 	$(CARGO) clean
 	rm -f $(PLUGIN_SO)
-	rm -rf $(OUT) .pytest_cache
+	rm -rf $(OUT) $(BENCH_OUT) .pytest_cache
 	find . -path ./$(VENV) -prune -o -type d -name __pycache__ -prune -exec rm -rf {} +
 
 distclean: clean

@@ -130,8 +130,14 @@ pub fn integrate_with(
     for g in band {
         let lambda = std::f64::consts::TAU / g.mu;
         let optics = optics_at(lambda)?;
+        let group = dispersion(plate, frame, beta, g.mu)?;
         let method = match method {
-            Method::Auto => auto(&optics, lambda, g.sigma),
+            Method::Auto => auto(
+                &optics,
+                lambda,
+                g.sigma,
+                group_round_trips(&optics, &group, g.mu),
+            ),
             m => m,
         };
         let (mr, mt) = match method {
@@ -145,7 +151,6 @@ pub fn integrate_with(
                     _ => coherent_order(&optics, lambda, g.sigma),
                 };
                 let paths = PathExpansion::new(&optics, order, lambda, want);
-                let group = dispersion(plate, frame, beta, g.mu)?;
                 let sum = |classes: &[PathClass], tail: &Matrix4<f64>| {
                     band_sum(classes, &paths, g, &group, output) + tail
                 };
@@ -177,19 +182,32 @@ fn round_trip(optics: &SlabOptics) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// The smallest and largest group path per unit thickness of one internal round trip,
+/// `d(k Re(q↑ − q↓))/dk` over the mode pairs (the phase index without dispersion).
+fn group_round_trips(optics: &SlabOptics, disp: &Dispersion, mu: f64) -> (f64, f64) {
+    let m = optics.layer_modes();
+    let trips = (0..2).flat_map(|a| {
+        (0..2).map(move |b| (m.up[a].q - m.down[b].q).re + mu * (disp.d1[2 + a] + disp.d1[b]))
+    });
+    trips.fold((f64::INFINITY, 0.0), |(lo, hi), t| (lo.min(t), hi.max(t)))
+}
+
 /// [`Method::Auto`]'s choice for one Gaussian. With `a = σ D` per round trip and `N` the
 /// number of round trips whose amplitude exceeds [`ORDER_TOLERANCE`], the integrand oscillates
 /// up to `a (N + 1)` radians per band width: Gauss–Hermite with `8 + 3x + x²` nodes integrates
 /// `exp(i x X)` to ~1e-6 up to `x = `[`HERMITE_LIMIT`] (128 nodes); beyond, the closed-form path
 /// classes take over (validated against dense quadrature in `tests/spectral_band.rs`).
-fn auto(optics: &SlabOptics, lambda: f64, sigma: f64) -> Method {
-    let a = sigma * optics.thickness_nm * round_trip(optics);
+/// The group path (not the phase path) sets how fast the integrand oscillates: strongly
+/// dispersive media (rutile's group index reaches ~9 near 360 nm) oscillate much faster than
+/// their phase index suggests.
+fn auto(optics: &SlabOptics, lambda: f64, sigma: f64, (rt_min, rt_max): (f64, f64)) -> Method {
+    let a = sigma * optics.thickness_nm * rt_max;
     let n = amplitude_order(optics, lambda, MAX_PANEL_ORDER);
     let x = a * (n as f64 + 1.0);
     if x <= HERMITE_LIMIT {
         return Method::Hermite(((8.0 + 3.0 * x + x * x).ceil() as usize).min(hermite::MAX_NODES));
     }
-    if a > PAIR_CUTOFF {
+    if sigma * optics.thickness_nm * rt_min > PAIR_CUTOFF {
         // Orders mutually incoherent: a few coherent orders and the incoherent tail.
         return Method::Paths(None);
     }
@@ -276,8 +294,14 @@ pub fn integrate_set(
     let centre = std::f64::consts::TAU / (0.5 * (lo + hi));
     let optics = plate.at(centre)?.optics(frame, beta)?;
     let orders = amplitude_order(&optics, centre, MAX_PANEL_ORDER) as f64 + 1.0;
-    let oscillations =
-        optics.thickness_nm * round_trip(&optics) * orders * (hi - lo) / std::f64::consts::TAU;
+    // The fastest oscillation: the largest group round trip, at the centre and at the short
+    // wavelength end (where dispersion is steepest).
+    let mut rt = 0.0f64;
+    for k in [0.5 * (lo + hi), hi] {
+        let o = plate.at(std::f64::consts::TAU / k)?.optics(frame, beta)?;
+        rt = rt.max(group_round_trips(&o, &dispersion(plate, frame, beta, k)?, k).1);
+    }
+    let oscillations = optics.thickness_nm * rt * orders * (hi - lo) / std::f64::consts::TAU;
     let panels = ((2.0 * oscillations).ceil() as usize).max(8);
     if panels * 8 > SHARED_NODES_MAX {
         let one = |c: usize| integrate(plate, frame, beta, bands[c], want, output);
