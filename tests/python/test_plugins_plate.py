@@ -168,6 +168,30 @@ def test_thin_plate_equals_retarder_at_normal_incidence(theta, dn):
     print(f"theta {theta}, dn {dn}: max |plate - retarder| (normalised) = {worst:.2e}")
 
 
+@pytest.mark.parametrize("theta", [0.0, 30.0, 75.0])
+def test_strongly_dichroic_plate_approaches_polarizer(theta):
+    """A plate whose extraordinary wave is absorbed (kappa_e = 0.05 over 30 um: exp(-4 pi kappa d /
+    lambda) < 1e-10) and index-matched ordinary wave transmits only light polarised
+    perpendicular to its optic axis: a linear polariser. Mitsuba's `polarizer` transmits along
+    cos(th) s - sin(th) t, i.e. at -th from s towards t, so an optic axis at `theta` (transmission
+    at theta + 90) matches polarizer(90 - theta). Compared normalised by M00 at normal
+    incidence, both sides; tolerance 1e-6 (the
+    o wave's Fresnel factors are the same for every polarisation, so only float32 remains)."""
+    variant(POLARIZED)
+    t = math.radians(theta)
+    ours = plate(eta_o=1.5, eta_e=1.5, kappa_e=0.05, ext_ior=1.5, thickness=30.0,
+                 filter_bandwidth=0.0, optic_axis=[math.cos(t), math.sin(t), 0.0])
+    pol = mi.load_dict({"type": "polarizer", "theta": 90.0 - theta})
+    for side in (1, -1):
+        si = surface_interaction(direction(0, 0, side), wavelengths=[550.0] * 4)
+        bs, w = sample(ours, context(component=1), si)
+        bs_p, w_p = sample(pol, context(), si)
+        np.testing.assert_allclose(wo_of(bs), wo_of(bs_p), atol=1e-6)
+        a = w[..., 0] / w[0, 0, 0]
+        b = w_p[..., 0] / w_p[0, 0, 0]
+        assert np.abs(a - b).max() <= 1e-6, (side, a, b)
+
+
 # ---- null transmission, energy, reciprocity ------------------------------------------------
 
 
