@@ -316,6 +316,45 @@ fn plate_query(m: &Material, g: &BfrGeometry, flags: i32) -> Result<PlateQuery> 
     )
 }
 
+/// The shared body of the plate entry points: validates the pointers, evaluates the plate over
+/// `spectrum` and writes one `[reflection, transmission]` pair per channel into `out`.
+///
+/// # Safety
+/// As for the entry points; `out` holds `2 × channels` entries.
+#[allow(clippy::too_many_arguments)]
+unsafe fn plate_entry(
+    m: *const BfrMaterial,
+    g: *const BfrGeometry,
+    spectrum: Spectrum,
+    channels: usize,
+    wi: *const f64,
+    transport_mode: i32,
+    flags: i32,
+    out: *mut BfrPathLobe,
+    message: *mut c_char,
+    message_len: usize,
+) -> i32 {
+    // SAFETY: pointer contracts of the entry points.
+    unsafe {
+        guarded(message, message_len, || {
+            let (m, g) = (
+                m.as_ref().ok_or_else(|| null("material"))?,
+                g.as_ref().ok_or_else(|| null("geometry"))?,
+            );
+            if out.is_null() {
+                return Err(null("out"));
+            }
+            let out = std::slice::from_raw_parts_mut(out, 2 * channels);
+            let q = plate_query(&m.0, g, flags)?;
+            let lobes = plate_lobes(&q, &spectrum, vec3(wi, "wi")?, transport(transport_mode)?)?;
+            for (c, l) in lobes.iter().enumerate().take(channels) {
+                emit_plate(l, &mut out[2 * c..2 * c + 2])?;
+            }
+            Ok(())
+        })
+    }
+}
+
 /// Plate lobes at one wavelength (exact or band-filtered).
 ///
 /// # Safety
@@ -333,25 +372,24 @@ pub unsafe extern "C" fn bfr_plate_lobes(
     message: *mut c_char,
     message_len: usize,
 ) -> i32 {
-    // SAFETY: pointer contracts above.
+    let spectrum = Spectrum::Band {
+        wavelength_nm,
+        fwhm_nm,
+    };
+    // SAFETY: the caller's contract is plate_entry's with one channel.
     unsafe {
-        guarded(message, message_len, || {
-            let (m, g) = (
-                m.as_ref().ok_or_else(|| null("material"))?,
-                g.as_ref().ok_or_else(|| null("geometry"))?,
-            );
-            if out.is_null() {
-                return Err(null("out"));
-            }
-            let out = std::slice::from_raw_parts_mut(out, 2);
-            let q = plate_query(&m.0, g, flags)?;
-            let spectrum = Spectrum::Band {
-                wavelength_nm,
-                fwhm_nm,
-            };
-            let lobes = plate_lobes(&q, &spectrum, vec3(wi, "wi")?, transport(transport_mode)?)?;
-            emit_plate(&lobes[0], out)
-        })
+        plate_entry(
+            m,
+            g,
+            spectrum,
+            1,
+            wi,
+            transport_mode,
+            flags,
+            out,
+            message,
+            message_len,
+        )
     }
 }
 
@@ -387,25 +425,21 @@ pub unsafe extern "C" fn bfr_plate_lobes_rgb(
     message: *mut c_char,
     message_len: usize,
 ) -> i32 {
-    // SAFETY: pointer contracts above.
+    let spectrum = Spectrum::Weights(WeightSet::SrgbD65);
+    // SAFETY: the caller's contract is plate_entry's with three channels.
     unsafe {
-        guarded(message, message_len, || {
-            let (m, g) = (
-                m.as_ref().ok_or_else(|| null("material"))?,
-                g.as_ref().ok_or_else(|| null("geometry"))?,
-            );
-            if out.is_null() {
-                return Err(null("out"));
-            }
-            let out = std::slice::from_raw_parts_mut(out, 6);
-            let q = plate_query(&m.0, g, flags)?;
-            let spectrum = Spectrum::Weights(WeightSet::SrgbD65);
-            let lobes = plate_lobes(&q, &spectrum, vec3(wi, "wi")?, transport(transport_mode)?)?;
-            for (c, l) in lobes.iter().enumerate() {
-                emit_plate(l, &mut out[2 * c..2 * c + 2])?;
-            }
-            Ok(())
-        })
+        plate_entry(
+            m,
+            g,
+            spectrum,
+            3,
+            wi,
+            transport_mode,
+            flags,
+            out,
+            message,
+            message_len,
+        )
     }
 }
 
