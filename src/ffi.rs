@@ -253,15 +253,22 @@ fn emit(lobes: &[PathLobe], out: &mut [BfrPathLobe]) -> Result<()> {
         return Err(Error::new("internal", "more lobes than the output holds"));
     }
     for (o, l) in out.iter_mut().zip(lobes) {
-        *o = lobe(l);
-        if !finite(o) {
-            return Err(Error::new(
-                "internal",
-                "non-finite result (a bug: please report the input)",
-            ));
-        }
+        *o = checked(l)?;
     }
     Ok(())
+}
+
+/// The C form of a lobe, refusing non-finite numbers (never handed to the renderer).
+fn checked(l: &PathLobe) -> Result<BfrPathLobe> {
+    let o = lobe(l);
+    if finite(&o) {
+        Ok(o)
+    } else {
+        Err(Error::new(
+            "internal",
+            "non-finite result (a bug: please report the input)",
+        ))
+    }
 }
 
 /// Bulk crystal lobes seen from `wi`.
@@ -396,16 +403,10 @@ pub unsafe extern "C" fn bfr_plate_lobes(
 /// Writes `[reflection, transmission]` into `out[0..2]`.
 fn emit_plate(lobes: &[Option<PathLobe>; 2], out: &mut [BfrPathLobe]) -> Result<()> {
     for (o, l) in out.iter_mut().zip(lobes) {
-        *o = BfrPathLobe::default();
-        if let Some(l) = l {
-            *o = lobe(l);
-            if !finite(o) {
-                return Err(Error::new(
-                    "internal",
-                    "non-finite result (a bug: please report the input)",
-                ));
-            }
-        }
+        *o = match l {
+            Some(l) => checked(l)?,
+            None => BfrPathLobe::default(),
+        };
     }
     Ok(())
 }
