@@ -11,6 +11,7 @@
 
 use crate::cmath;
 use crate::error::{Error, Result};
+use crate::fresnel::Fresnel;
 use crate::medium::Uniaxial;
 use crate::modes::{modes, Mode, ModeSet};
 use nalgebra::{Matrix2, Matrix4};
@@ -39,8 +40,28 @@ fn put(m: &mut Matrix4<C64>, offset: usize, pair: &[Mode; 2], sign: f64) {
 impl Interface {
     /// Solves the interface between `upper` and `lower` (axes in the working frame) for the
     /// incidence parameter `beta`.
+    /// Two isotropic media take the closed-form Fresnel amplitudes ([`Fresnel`]; the same
+    /// matrix as the 4x4 solve, which `tests/interface_physics.rs` checks).
     pub fn new(upper: &Uniaxial, lower: &Uniaxial, beta: C64) -> Result<Self> {
-        Self::from_modes(modes(upper, beta), modes(lower, beta))
+        let (m1, m2) = (modes(upper, beta), modes(lower, beta));
+        if upper.is_isotropic() && lower.is_isotropic() {
+            let f = Fresnel::new(upper.eta_o, lower.eta_o, beta).ok_or_else(singular)?;
+            return Ok(Self::isotropic(m1, m2, &f));
+        }
+        Self::from_modes(m1, m2)
+    }
+
+    /// The interface of two isotropic media from its Fresnel amplitudes: every block of `S`
+    /// is diagonal in the s/p bases.
+    fn isotropic(upper: ModeSet, lower: ModeSet, f: &Fresnel) -> Self {
+        let mut s = Matrix4::zeros();
+        for k in 0..2 {
+            s[(k, k)] = f.r_above[k];
+            s[(2 + k, k)] = f.t_above[k];
+            s[(k, 2 + k)] = f.t_below[k];
+            s[(2 + k, 2 + k)] = f.r_below[k];
+        }
+        Interface { upper, lower, s }
     }
 
     /// Solves the boundary system for given mode sets (seed eq. S18).

@@ -57,6 +57,21 @@ pub fn cross(j1: &Matrix2<C64>, j2: &Matrix2<C64>) -> Matrix4<C64> {
     j1.map(|z| z.conj()).kronecker(j2)
 }
 
+/// The Mueller matrix of a coherency superoperator that is diagonal, `diag(ss, sp, conj(sp),
+/// pp)`: that of a diagonal Jones matrix `diag(a, b)` (or of a sum of such), with `ss = |a|²`,
+/// `sp = conj(a) b`, `pp = |b|²` (or their averages). `from_coherency` written out:
+/// `M₀₀ = M₁₁ = (ss + pp)/2`, `M₀₁ = M₁₀ = (ss − pp)/2`, `M₂₂ = M₃₃ = Re sp`,
+/// `M₂₃ = −M₃₂ = Im sp`.
+pub fn from_diagonal(ss: f64, sp: C64, pp: f64) -> Matrix4<f64> {
+    let (a, d) = (0.5 * (ss + pp), 0.5 * (ss - pp));
+    Matrix4::new(
+        a, d, 0.0, 0.0, //
+        d, a, 0.0, 0.0, //
+        0.0, 0.0, sp.re, sp.im, //
+        0.0, 0.0, -sp.im, sp.re,
+    )
+}
+
 /// The Mueller matrix `Re(A K A⁻¹)` of a coherency superoperator.
 pub fn from_coherency(k: &Matrix4<C64>) -> Matrix4<f64> {
     (a_matrix() * k * a_inverse()).map(|x| x.re)
@@ -165,5 +180,13 @@ mod tests {
             0.5, 0.5, 0.0, 0.0, 0.5, 0.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
         );
         assert!((m - want).norm() < 1e-15);
+    }
+
+    #[test]
+    fn diagonal_closed_form_equals_the_coherency_route() {
+        let (a, b) = (C64::new(0.3, -0.7), C64::new(-0.45, 0.2));
+        let j = Matrix2::new(a, C64::new(0.0, 0.0), C64::new(0.0, 0.0), b);
+        let m = from_diagonal(a.norm_sqr(), a.conj() * b, b.norm_sqr());
+        assert!((m - from_coherency(&coherency(&j))).norm() < 1e-15);
     }
 }

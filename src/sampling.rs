@@ -374,9 +374,7 @@ fn physical_plate(
             if fwhm_nm == 0.0 {
                 vec![q
                     .plate
-                    .at(wavelength_nm)?
-                    .optics(&frame, beta)?
-                    .mueller(wavelength_nm, want)?]
+                    .mueller_at(wavelength_nm, &frame, beta, want, q.output)?]
             } else {
                 vec![one(&[narrow_band(wavelength_nm, fwhm_nm)])?]
             }

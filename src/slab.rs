@@ -18,7 +18,7 @@ use crate::error::{Error, Result};
 use crate::frame::PlaneFrame;
 use crate::interface::Interface;
 use crate::medium::{check_clear_index, Uniaxial};
-use crate::modes::{modes, ModeSet};
+use crate::modes::{modes, normal_components, ModeSet};
 use crate::mueller;
 use nalgebra::{Matrix2, Matrix4};
 use num_complex::Complex64 as C64;
@@ -111,6 +111,14 @@ impl Slab {
         )
     }
 
+    /// The layer's normal components `[o↓, e↓, o↑, e↑]` ([`normal_components`]).
+    pub fn layer_q(&self, frame: &PlaneFrame, beta: C64) -> [C64; 4] {
+        normal_components(
+            &self.layer.with_axis(frame.to_working(self.layer.axis)),
+            beta,
+        )
+    }
+
     /// Solves both interfaces for incidence parameter `beta` in the plane of `frame`.
     pub fn optics(&self, frame: &PlaneFrame, beta: C64) -> Result<SlabOptics> {
         let layer = self.layer.with_axis(frame.to_working(self.layer.axis));
@@ -133,14 +141,19 @@ impl SlabOptics {
 
     /// Propagation factors `(P↓, P↑)` through the layer at vacuum wavelength `lambda_nm`.
     pub fn propagation(&self, lambda_nm: f64) -> (Matrix2<C64>, Matrix2<C64>) {
-        let kd = std::f64::consts::TAU * self.thickness_nm / lambda_nm;
         let m = self.layer_modes();
+        let q = [m.down[0].q, m.down[1].q, m.up[0].q, m.up[1].q];
+        self.propagation_with(lambda_nm, &q)
+    }
+
+    /// Propagation factors for given normal components `[o↓, e↓, o↑, e↑]` of the layer's modes.
+    fn propagation_with(&self, lambda_nm: f64, q: &[C64; 4]) -> (Matrix2<C64>, Matrix2<C64>) {
+        let kd = std::f64::consts::TAU * self.thickness_nm / lambda_nm;
         let i = C64::new(0.0, 1.0);
-        let dn = |k: usize| (-i * m.down[k].q * kd).exp();
-        let up = |k: usize| (i * m.up[k].q * kd).exp();
+        let p = |k: usize, sign: f64| (i * q[k] * (sign * kd)).exp();
         (
-            Matrix2::from_diagonal(&nalgebra::Vector2::new(dn(0), dn(1))),
-            Matrix2::from_diagonal(&nalgebra::Vector2::new(up(0), up(1))),
+            Matrix2::from_diagonal(&nalgebra::Vector2::new(p(0, -1.0), p(1, -1.0))),
+            Matrix2::from_diagonal(&nalgebra::Vector2::new(p(2, 1.0), p(3, 1.0))),
         )
     }
 
@@ -159,7 +172,27 @@ impl SlabOptics {
     /// Fails only at an exact internal resonance (`I − D` singular: a guided mode, which light
     /// from outside cannot excite in a passive slab).
     pub fn jones(&self, lambda_nm: f64, want: Want) -> Result<SlabJones> {
-        let (pd, pu) = self.propagation(lambda_nm);
+        self.jones_with(self.propagation(lambda_nm), want)
+    }
+
+    /// [`SlabOptics::jones`] with the interfaces of `self` and the layer phases of the normal
+    /// components `q` (`[o↓, e↓, o↑, e↑]`, e.g. [`crate::modes::normal_components`] at a nearby
+    /// wavelength): a dispersive plate across a narrow band, where the amplitudes barely change
+    /// but the phases do.
+    pub fn mueller_with_phases(
+        &self,
+        lambda_nm: f64,
+        q: &[C64; 4],
+        want: Want,
+    ) -> Result<SlabMueller> {
+        let j = self.jones_with(self.propagation_with(lambda_nm, q), want)?;
+        Ok(SlabMueller {
+            r: j.r.as_ref().map(mueller::from_jones),
+            t: j.t.as_ref().map(mueller::from_jones),
+        })
+    }
+
+    fn jones_with(&self, (pd, pu): (Matrix2<C64>, Matrix2<C64>), want: Want) -> Result<SlabJones> {
         let (t1, r1) = (self.top.t_above(), self.top.r_above());
         let (t3, r3) = (self.top.t_below(), self.top.r_below());
         let (t2, r2) = (self.bottom.t_above(), self.bottom.r_above());

@@ -2,9 +2,12 @@
 //! each wavelength it needs.
 
 use crate::error::Result;
+use crate::etalon::Etalon;
+use crate::frame::PlaneFrame;
 use crate::material::Material;
 use crate::medium::Uniaxial;
-use crate::slab::Slab;
+use crate::slab::{Slab, SlabMueller, Want};
+use crate::spectral::integrate::Output;
 use nalgebra::Vector3;
 use num_complex::Complex64 as C64;
 
@@ -40,5 +43,40 @@ impl Plate {
     /// True if any index varies with wavelength.
     pub fn is_dispersive(&self) -> bool {
         self.material.is_dispersive()
+    }
+
+    /// The isotropic fast path ([`Etalon`]) for incidence parameter `beta`, where it applies:
+    /// a non-dispersive plate with `η_o = η_e` real and no added birefringence, the wave
+    /// propagating in it. (The layer's indices do not depend on `lambda_nm` then; it only
+    /// selects where [`Material::indices`] is evaluated.)
+    pub fn etalon(&self, lambda_nm: f64, beta: C64) -> Option<Etalon> {
+        if self.is_dispersive() || self.birefringence != 0.0 {
+            return None;
+        }
+        let (eo, ee) = self.material.indices(lambda_nm, 0.0).ok()?;
+        if eo != ee {
+            return None;
+        }
+        Etalon::new(self.ext, eo, self.exit, beta, self.thickness_nm)
+    }
+
+    /// The exact Mueller matrices at `lambda_nm` (s/p frames of `frame`): the isotropic fast
+    /// path where it applies, else the general slab ([`Slab::optics`], full Mueller matrices
+    /// whatever `output` asks).
+    pub fn mueller_at(
+        &self,
+        lambda_nm: f64,
+        frame: &PlaneFrame,
+        beta: C64,
+        want: Want,
+        output: Output,
+    ) -> Result<SlabMueller> {
+        match self.etalon(lambda_nm, beta) {
+            Some(e) => Ok(e.mueller(lambda_nm, want, output)),
+            None => self
+                .at(lambda_nm)?
+                .optics(frame, beta)?
+                .mueller(lambda_nm, want),
+        }
     }
 }
