@@ -15,6 +15,7 @@ pub mod ffi;
 pub mod frame;
 pub mod fresnel;
 pub mod interface;
+pub mod isotropic;
 pub mod lobes;
 pub mod material;
 pub mod medium;

@@ -76,16 +76,16 @@ pub fn scatter(
         Incident::Inside(_) => Group::Single(2),
     };
     let in_modes = [
-        i.upper.down[0],
-        i.upper.down[1],
-        i.lower.up[0],
-        i.lower.up[1],
+        &i.upper.down[0],
+        &i.upper.down[1],
+        &i.lower.up[0],
+        &i.lower.up[1],
     ];
     let out_modes = [
-        i.upper.up[0],
-        i.upper.up[1],
-        i.lower.down[0],
-        i.lower.down[1],
+        &i.upper.up[0],
+        &i.upper.up[1],
+        &i.lower.down[0],
+        &i.lower.down[1],
     ];
     let first_in = in_modes[input.first()];
     let p_in = first_in.flux.abs();
@@ -100,11 +100,11 @@ pub fn scatter(
             frame.s,
             Vector2::new(C64::new(1.0, 0.0), C64::new(0.0, 0.0)),
         ),
-        Group::Single(_) => crystal_frame(&sv, &first_in),
+        Group::Single(_) => crystal_frame(&sv, first_in),
     };
     let make = |group: Group| -> Option<Lobe> {
         let mode = out_modes[group.first()];
-        if !carries_power(&mode) {
+        if !carries_power(mode) {
             return None;
         }
         let row = |r: usize| -> Vector2<C64> {
@@ -119,12 +119,12 @@ pub fn scatter(
                 Matrix2::from_rows(&[row(r0).transpose(), row(r1).transpose()]),
             ),
             Group::Single(r) => {
-                let (x, c) = crystal_frame(&sv, &mode);
+                let (x, c) = crystal_frame(&sv, mode);
                 (x, c * row(r).transpose())
             }
         };
         let jones = amplitudes * C64::new((mode.flux.abs() / p_in).sqrt(), 0.0);
-        Some(lobe(&sv, &mode, x, jones))
+        Some(lobe(&sv, mode, x, jones))
     };
     let exterior = make(Group::Pair([0, 1]));
     let crystal = if iso {

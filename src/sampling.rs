@@ -11,6 +11,7 @@
 
 use crate::error::{Error, Result};
 use crate::frame::PlaneFrame;
+use crate::isotropic;
 use crate::lobes::{scatter, Event, Lobe};
 use crate::material::Material;
 use crate::medium::{check_clear_index, Uniaxial};
@@ -90,19 +91,40 @@ fn outgoing(event: &Event, incident: Option<ModeKind>) -> Vec<(usize, Option<Mod
     v
 }
 
-/// Lobes of a bulk crystal surface seen from `wi` (unit, local; `wi.z < 0` is inside).
+/// Lobes of a bulk crystal surface seen from `wi` (unit, local; `wi.z < 0` is inside). A
+/// lossless isotropic crystal takes the closed form of [`crate::isotropic`].
 pub fn crystal_lobes(
     surface: &Surface,
     wi: Vector3<f64>,
     transport: Transport,
 ) -> Result<Vec<PathLobe>> {
+    let Some(wi) = checked_direction(wi)? else {
+        return Ok(Vec::new());
+    };
+    if let Some(lobes) = isotropic::crystal_lobes(surface, wi, transport) {
+        return Ok(lobes);
+    }
+    crystal_lobes_full(surface, wi, transport)
+}
+
+/// `wi` normalised, `None` at exactly grazing incidence (no lobes); an error unless unit.
+fn checked_direction(wi: Vector3<f64>) -> Result<Option<Vector3<f64>>> {
     if !(wi.iter().all(|x| x.is_finite()) && (wi.norm() - 1.0).abs() < 1e-4) {
         return Err(Error::new("wi", "must be a unit vector"));
     }
-    if wi.z == 0.0 {
+    Ok((wi.z != 0.0).then(|| wi.normalize()))
+}
+
+/// [`crystal_lobes`] by the general computation (every case, isotropic ones included): the
+/// reference the isotropic fast path is tested against.
+pub fn crystal_lobes_full(
+    surface: &Surface,
+    wi: Vector3<f64>,
+    transport: Transport,
+) -> Result<Vec<PathLobe>> {
+    let Some(wi) = checked_direction(wi)? else {
         return Ok(Vec::new());
-    }
-    let wi = wi.normalize();
+    };
     let mut lobes = Vec::new();
     for (inc, event) in forward_events(surface, wi)? {
         for (component, mode, l) in outgoing(&event, inc) {

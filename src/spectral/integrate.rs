@@ -143,7 +143,7 @@ pub fn integrate_with(
         let group = dispersion(plate, frame, beta, g.mu)?;
         if method == Method::Auto && g.sigma <= NARROW_BAND * g.mu {
             if let Some((mr, mt)) =
-                narrow::band(&optics, g, &traversal_groups(&optics, &group, g.mu), want)
+                narrow::band(&optics, g, &traversals(&optics, &group, g.mu), want)
             {
                 r += mr * g.amplitude;
                 t += mt * g.amplitude;
@@ -250,20 +250,24 @@ pub fn narrow_closed_form(
     let optics = plate
         .at(std::f64::consts::TAU / g.mu)?
         .optics(frame, beta)?;
-    let group = traversal_groups(&optics, &dispersion(plate, frame, beta, g.mu)?, g.mu);
+    let t = traversals(&optics, &dispersion(plate, frame, beta, g.mu)?, g.mu);
     Ok(
-        narrow::band(&optics, g, &group, want).map(|(r, t)| SlabMueller {
+        narrow::band(&optics, g, &t, want).map(|(r, t)| SlabMueller {
             r: want.reflection.then_some(r),
             t: want.transmission.then_some(t),
         }),
     )
 }
 
-/// Group index `d(k Re Q_j)/dk` of each traversal `[o↓, e↓, o↑, e↑]` of the layer.
-fn traversal_groups(optics: &SlabOptics, disp: &Dispersion, mu: f64) -> [f64; 4] {
+/// How each traversal's phase varies around `mu` ([`narrow::Traversal`]), from the modes at
+/// the centre and the dispersion derivatives.
+fn traversals(optics: &SlabOptics, disp: &Dispersion, mu: f64) -> [narrow::Traversal; 4] {
     let m = optics.layer_modes();
     let q = [-m.down[0].q, -m.down[1].q, m.up[0].q, m.up[1].q];
-    std::array::from_fn(|j| q[j].re + mu * disp.d1[j])
+    std::array::from_fn(|j| narrow::Traversal {
+        group: q[j] + mu * disp.d1[j],
+        curvature: 2.0 * disp.d1[j] + mu * disp.d2[j],
+    })
 }
 
 /// The smallest and largest group path per unit thickness of one internal round trip,

@@ -1,122 +1,309 @@
 //! A narrow band through a birefringent plate in closed form: the plate as a matrix etalon.
 //!
-//! Across a band narrow enough that the interface amplitudes and the layer's birefringent
-//! phase differences do not change (σ ≪ μ and `σ d |G_j − ḡ| ≪ 1`), the only fast variation
-//! is the common phase of the internal round trips. With the wavenumber `k = μ + κ`, each
-//! traversal of the layer in mode `j` has the phase `μ d Q_j + κ d G_j` (`G_j = Q_j + μ Q_j'`
-//! its group index); writing `G_j = ḡ + δ_j` and neglecting `κ d δ_j`, one round trip is
-//! `D(k) = h D̃` with `D̃ = r₃ P↑(μ) r₂ P↓(μ)` (the exact round trip at the centre) and the
-//! scalar `h = exp(2 i κ d ḡ)`. Then `J_T = t₂ P↓ Σₙ hⁿ D̃ⁿ t₁` and, as for the scalar
-//! etalon ([`crate::etalon`]), a pair of orders `(n, n + Δ)` keeps `⟨h^Δ⟩ = g(Δ) =
-//! exp(−2 σ² d² ḡ² Δ²)` of its coherence. With Kronecker products (`cross(A, B) = conj(A) ⊗ B`,
-//! [`crate::mueller::cross`]) the double sum over orders becomes a geometric series of
-//! `K = conj(D̃) ⊗ D̃`:
+//! Across a narrow band (σ ≪ μ) the interface amplitudes barely change (they are taken at the
+//! centre, as the pair sums of [`crate::spectral::integrate`] do) and each traversal of the
+//! layer in mode `j` has the phase `μ d Q_j + κ d G_j` at `k = μ + κ` (`G_j = Q_j + μ Q_j'`
+//! its group index). Write `G_j = ḡ + δ_j`: the common part `ḡ` is the fast phase of the
+//! internal round trips, `h = exp(2 i κ d ḡ)` per round trip; the residuals `δ_j` (the
+//! birefringent group differences) are slow. With `P↓(κ) = diag(p_j e^{i κ d δ_j})` (`p_j` the
+//! propagation at the centre), `D(κ) = r₃ P↑ r₂ P↓` and `Aₙ = X D(κ)ⁿ t₁` (`X = t₂ P↓` times
+//! the flux factor for transmission), the coherency is a double sum over orders whose pairs
+//! `(n, n + Δ)` carry `h^Δ`. The Gaussian average of `e^{i κ a} F(κ)` (`κ = σ x`, `x` standard
+//! normal, `a = 2 Δ d ḡ`) is, shifting the contour,
 //!
 //! ```text
-//! Σ_{n,m} g(m − n) conj(Aₙ) ⊗ Aₘ = (conj X ⊗ X) (I − K)⁻¹ B (conj t₁ ⊗ t₁),   Aₙ = X D̃ⁿ t₁
-//! B = I + I ⊗ P + conj(P) ⊗ I,      P = Σ_{Δ≥1} g(Δ) D̃^Δ
+//! ⟨e^{i κ a} F(κ)⟩ = e^{−σ² a²/2} E_x[F(σ x + i σ² a)]
 //! ```
-//! with `X = t₂ P↓` for transmission (times the flux factor), and for reflection
-//! `R = r₁ + Σ_{n≥1} hⁿ V D̃ⁿ⁻¹ t₁` (`V = t₃ P↑ r₂ P↓`):
-//! `⟨conj R ⊗ R⟩ = conj r₁ ⊗ r₁ + conj r₁ ⊗ V S t₁ + conj(V S t₁) ⊗ r₁ + (conj V ⊗ V)(I − K)⁻¹ B
-//! (conj t₁ ⊗ t₁)`, `S = Σ_{j≥0} g(j + 1) D̃ʲ`. The neglected residual changes the coherence
-//! of a pair by at most `σ² Φ²/2`, `Φ` its residual group path difference, which
-//! [`RESIDUAL_MAX`] bounds (tests/spectral_narrow.rs measures the error against dense
-//! quadrature).
+//! exact for entire `F`; `F` varies slowly in `κ` (the residual phases), so a few Gauss–Hermite
+//! nodes give `E_x` (their number set by the largest residual path difference over the band).
+//! Summing the orders with Kronecker products (`Ā(z) = conj(A(z̄))` the continuation of the
+//! conjugated amplitude):
+//!
+//! ```text
+//! Σₙ Āₙ(z) ⊗ Aₙ₊Δ(z) = (X̄ ⊗ X) (I − D̄ ⊗ D)⁻¹ (I ⊗ D^Δ) (t̄₁ ⊗ t₁)        (Δ ≥ 0)
+//! ```
+//! and for reflection `R = r₁ + Σ_{n≥1} hⁿ V Dⁿ⁻¹ t₁` (`V = t₃ P↑ r₂ P↓`), the same with `V` for
+//! `X` plus the cross terms of `r₁` with each order. Pairs with `Δ < 0` are the mirror images:
+//! `Āₘ ⊗ Aₙ = S conj(Āₙ ⊗ Aₘ) S` (`S` swaps the Kronecker factors). Exact for phases linear in
+//! `κ` over the band and amplitudes constant: the same model as the pair sums, with every
+//! internal order included. The residuals are complex (absorption varies across the band with
+//! `Im G_j`) and also carry the curvature `κ² C_j/2` of each traversal's phase.
 
 use crate::cmath;
-use crate::mueller;
 use crate::slab::{SlabOptics, Want};
+use crate::spectral::hermite;
 use crate::spectral::weights::Gaussian;
 use nalgebra::{Matrix2, Matrix4};
 use num_complex::Complex64 as C64;
 
-/// Largest residual `σ d max_j |G_j − ḡ|` (radians per band width) of the propagating modes
-/// for which the closed form is used.
-pub const RESIDUAL_MAX: f64 = 0.01;
 /// A mode attenuated by more than `exp(−ATTENUATED)` in one traversal carries nothing.
 const ATTENUATED: f64 = 40.0;
-/// Series terms below this are dropped.
+/// Orders whose pair weight `g(Δ) ‖D‖^Δ` falls below this are dropped.
 const SERIES_TOLERANCE: f64 = 1e-13;
-/// Longest series; beyond, the caller uses the general method.
-const MAX_TERMS: usize = 4096;
+/// Longest order series; beyond, the caller uses the general method.
+const MAX_TERMS: usize = 512;
+/// Most Gauss–Hermite nodes spent on the residual phases; beyond, the general method.
+pub const MAX_NODES: usize = 48;
+/// Accuracy asked of the Gauss–Hermite rule for the residual phases (for a pair of weight 1).
+const NODE_TOLERANCE: f64 = 1e-9;
+
+/// How the phase `k d Q_j(k)` of one traversal of the layer varies around the centre `μ`
+/// (per unit thickness): `μ Q_j + κ G_j + κ² C_j/2`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Traversal {
+    /// `d(k Q)/dk`: the group index, its imaginary part the attenuation rate (complex `Q`).
+    pub group: C64,
+    /// `d²(k Q)/dk²` (group velocity dispersion).
+    pub curvature: f64,
+}
 
 /// The band-averaged Mueller matrices `(R, T)` (zero where not wanted) of the plate `optics`
-/// (solved at the band's centre) over the unit-mass Gaussian `g`, given the group indices
-/// `group` of the four traversals `[o↓, e↓, o↑, e↑]` at the centre. `None` if the residual is
-/// too large or the series too long.
+/// (solved at the band's centre) over the unit-mass Gaussian `g`, given how the phases of the
+/// four traversals `[o↓, e↓, o↑, e↑]` vary across it (`traversals`). `None` where the closed
+/// form does not apply (too many orders or nodes, or an order series that does not converge
+/// once shifted into the complex plane: plates near grazing incidence, very thick and strongly
+/// birefringent ones); the caller then uses the general method.
 pub fn band(
     optics: &SlabOptics,
     g: &Gaussian,
-    group: &[f64; 4],
+    traversals: &[Traversal; 4],
     want: Want,
 ) -> Option<(Matrix4<f64>, Matrix4<f64>)> {
-    let lambda = std::f64::consts::TAU / g.mu;
-    let d = optics.thickness_nm;
-    let m = optics.layer_modes();
-    let q = [-m.down[0].q, -m.down[1].q, m.up[0].q, m.up[1].q];
-    let live: Vec<f64> = (0..4)
-        .filter(|&j| g.mu * d * q[j].im < ATTENUATED)
-        .map(|j| group[j])
-        .collect();
-    let (lo, hi) = live
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &x| {
-            (l.min(x), h.max(x))
-        });
-    let gbar = if live.is_empty() {
-        0.0
-    } else {
-        0.5 * (lo + hi)
-    };
-    if !live.is_empty() && g.sigma * d * 0.5 * (hi - lo) > RESIDUAL_MAX {
-        return None;
+    let plate = Layer::new(optics, g, traversals)?;
+    let mut c_t = Matrix4::<C64>::zeros();
+    let mut c_r = Matrix4::<C64>::zeros();
+    let mut mirrored_t = Matrix4::<C64>::zeros();
+    let mut mirrored_r = Matrix4::<C64>::zeros();
+    let t1_bar = plate.t1.map(|z| z.conj());
+    for delta in 0..=plate.orders {
+        let gd = plate.coherence(delta);
+        if gd == 0.0 {
+            break;
+        }
+        // The pairs Δ orders apart weigh at most g(Δ) ‖D‖^Δ: their rule needs less accuracy.
+        let weight = gd * plate.rho.powi(delta as i32);
+        let phase = if delta == 0 {
+            plate.phase_same
+        } else {
+            plate.phase_orders
+        };
+        let nodes = hermite_nodes(phase, NODE_TOLERANCE / weight.max(1e-300))?;
+        for &(x, w) in hermite::rule(nodes) {
+            let z = C64::new(g.sigma * x, g.sigma * g.sigma * plate.fast(delta));
+            let m = plate.at(z)?;
+            // (I ⊗ D^Δ)(t̄₁ ⊗ t₁) = t̄₁ ⊗ D^Δ t₁.
+            let rhs = kron(&t1_bar, &(power(&m.d, delta) * plate.t1));
+            let y = cmath::solve4(&(Matrix4::identity() - kron(&m.d_bar, &m.d)), &rhs)?;
+            let weight = C64::new(w * gd, 0.0);
+            let (target_t, target_r) = if delta == 0 {
+                (&mut c_t, &mut c_r)
+            } else {
+                (&mut mirrored_t, &mut mirrored_r)
+            };
+            if want.transmission {
+                *target_t += kron(&m.x_bar, &m.x) * y * weight;
+            }
+            if want.reflection {
+                *target_r += kron(&m.v_bar, &m.v) * y * weight;
+                if delta >= 1 {
+                    // r₁ (no round trip) with order `delta`: conj(r₁) ⊗ V D^(Δ−1) t₁.
+                    let u = m.v * power(&m.d, delta - 1) * plate.t1;
+                    mirrored_r += kron(&plate.r1.map(|z| z.conj()), &u) * weight;
+                }
+            }
+        }
     }
-    let (pd, pu) = optics.propagation(lambda);
-    let (t1, r1) = (optics.top.t_above(), optics.top.r_above());
-    let (t3, r3) = (optics.top.t_below(), optics.top.r_below());
-    let (t2, r2) = (optics.bottom.t_above(), optics.bottom.r_above());
-    let dt = r3 * pu * r2 * pd;
-    let a = 2.0 * (g.sigma * d * gbar).powi(2);
-    let (p, s) = series(&dt, a)?;
-    let one = Matrix2::<C64>::identity();
-    let b = Matrix4::identity() + mueller::cross(&one, &p) + mueller::cross(&p, &one);
-    let k = Matrix4::identity() - mueller::cross(&dt, &dt);
-    let y = cmath::solve4(&k, &(b * mueller::cross(&t1, &t1)))?;
+    let close = |c: Matrix4<C64>, mirrored: Matrix4<C64>| {
+        crate::mueller::from_coherency(&(c + mirrored + swap(&mirrored.map(|z| z.conj()))))
+    };
     let t = if want.transmission {
-        let x = t2 * pd * C64::new(optics.transmission_flux_ratio().sqrt(), 0.0);
-        mueller::from_coherency(&(mueller::cross(&x, &x) * y))
+        close(
+            c_t * C64::new(plate.flux, 0.0),
+            mirrored_t * C64::new(plate.flux, 0.0),
+        )
     } else {
         Matrix4::zeros()
     };
     let r = if want.reflection {
-        let v = t3 * pu * r2 * pd;
-        let vst = v * s * t1;
-        let c = mueller::cross(&r1, &r1)
-            + mueller::cross(&r1, &vst)
-            + mueller::cross(&vst, &r1)
-            + mueller::cross(&v, &v) * y;
-        mueller::from_coherency(&c)
+        let direct = kron(&plate.r1.map(|z| z.conj()), &plate.r1);
+        close(c_r + direct, mirrored_r)
     } else {
         Matrix4::zeros()
     };
     Some((r, t))
 }
 
-/// `P = Σ_{Δ≥1} g(Δ) D̃^Δ` and `S = Σ_{j≥0} g(j + 1) D̃ʲ` with `g(Δ) = exp(−a Δ²)`.
-fn series(dt: &Matrix2<C64>, a: f64) -> Option<(Matrix2<C64>, Matrix2<C64>)> {
-    let (mut p, mut s) = (Matrix2::zeros(), Matrix2::zeros());
-    let mut power = Matrix2::<C64>::identity(); // D̃^(Δ−1)
-    let (mut gd, step, mut ratio) = (1.0f64, (-2.0 * a).exp(), (-a).exp());
-    for _ in 1..=MAX_TERMS {
-        gd *= ratio; // g(Δ) = g(Δ−1) exp(−a (2Δ − 1))
-        ratio *= step;
-        s += power * C64::new(gd, 0.0);
-        power *= *dt;
-        p += power * C64::new(gd, 0.0);
-        if power.norm() * gd < SERIES_TOLERANCE {
-            return Some((p, s));
+/// The plate over one band: centre amplitudes, residual rates and the rule's sizes.
+struct Layer {
+    r1: Matrix2<C64>,
+    t1: Matrix2<C64>,
+    r2: Matrix2<C64>,
+    t2: Matrix2<C64>,
+    r3: Matrix2<C64>,
+    t3: Matrix2<C64>,
+    /// Propagation factors at the centre, `[o↓, e↓, o↑, e↑]`.
+    p: [C64; 4],
+    /// Residual group path `d (G_j − ḡ)` of each traversal (nm; imaginary: attenuation).
+    residual: [C64; 4],
+    /// Phase curvature `d C_j` of each traversal (nm²).
+    curvature: [f64; 4],
+    /// `2 d ḡ`: the group path of one round trip (nm).
+    round_trip: f64,
+    /// `σ²`-scaled decay of the coherence between orders: `g(Δ) = exp(−decay Δ²)`.
+    decay: f64,
+    /// Transmission flux factor `P_exit/P_ext`.
+    flux: f64,
+    /// Highest order difference kept.
+    orders: usize,
+    /// Largest residual phase difference over one band width (rad) of a significant pair of
+    /// the same order, and of different orders.
+    phase_same: f64,
+    phase_orders: f64,
+    /// `‖D‖` at the centre (Frobenius): the decay of the orders.
+    rho: f64,
+}
+
+/// The amplitudes of one complex node `z`.
+struct AtNode {
+    d: Matrix2<C64>,
+    d_bar: Matrix2<C64>,
+    x: Matrix2<C64>,
+    x_bar: Matrix2<C64>,
+    v: Matrix2<C64>,
+    v_bar: Matrix2<C64>,
+}
+
+impl Layer {
+    fn new(optics: &SlabOptics, g: &Gaussian, traversals: &[Traversal; 4]) -> Option<Self> {
+        let d = optics.thickness_nm;
+        let m = optics.layer_modes();
+        let q = [-m.down[0].q, -m.down[1].q, m.up[0].q, m.up[1].q];
+        let live: [bool; 4] = std::array::from_fn(|j| g.mu * d * q[j].im < ATTENUATED);
+        let group = traversals.map(|t| t.group);
+        // ḡ: the middle of the live round trips' group indices (a down, b up), halved.
+        let (lo, hi) = (0..2)
+            .flat_map(|a| (2..4).map(move |b| (a, b)))
+            .filter(|&(a, b)| live[a] && live[b])
+            .map(|(a, b)| 0.5 * (group[a].re + group[b].re))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), x| {
+                (l.min(x), h.max(x))
+            });
+        let gbar = if lo <= hi { 0.5 * (lo + hi) } else { 0.0 };
+        let keep = |j: usize, v: C64| if live[j] { v } else { C64::new(0.0, 0.0) };
+        let residual: [C64; 4] = std::array::from_fn(|j| keep(j, (group[j] - gbar) * d));
+        let curvature: [f64; 4] =
+            std::array::from_fn(|j| keep(j, C64::new(d * traversals[j].curvature, 0.0)).re);
+        let p = std::array::from_fn(|j| (C64::new(0.0, g.mu * d) * q[j]).exp());
+        let mut layer = Layer {
+            r1: optics.top.r_above(),
+            t1: optics.top.t_above(),
+            r2: optics.bottom.r_above(),
+            t2: optics.bottom.t_above(),
+            r3: optics.top.r_below(),
+            t3: optics.top.t_below(),
+            p,
+            residual,
+            curvature,
+            round_trip: 2.0 * d * gbar,
+            decay: 0.5 * (g.sigma * 2.0 * d * gbar).powi(2),
+            flux: optics.transmission_flux_ratio(),
+            orders: 0,
+            phase_same: 0.0,
+            phase_orders: 0.0,
+            rho: 0.0,
+        };
+        let rho = layer.at(C64::new(0.0, 0.0))?.d.norm();
+        layer.rho = rho;
+        layer.orders = (1..=MAX_TERMS)
+            .find(|&n| layer.coherence(n) * rho.powi(n as i32) < SERIES_TOLERANCE)?;
+        // Residual phases over the band of the pairs that matter (up to 2N + 1 traversals, N
+        // the order where the amplitude falls below 1e-3). Pairs of the same order differ only
+        // in the mode of each traversal (o/e, same direction); pairs of different orders also
+        // by whole round trips (residual r_a↓ + r_b↑ and the curvature).
+        let n = (1..=MAX_TERMS).find(|&n| rho.powi(n as i32) < 1e-3)? as f64;
+        let (r, c) = (&layer.residual, &layer.curvature);
+        let same = (r[1] - r[0]).norm().max((r[3] - r[2]).norm());
+        let bend_same = (c[1] - c[0]).abs().max((c[3] - c[2]).abs());
+        let trip = (0..2)
+            .flat_map(|a| (2..4).map(move |b| (r[a] + r[b]).norm()))
+            .fold(0.0, f64::max);
+        let bend = c.iter().map(|c| c.abs()).fold(0.0, f64::max);
+        let s2 = g.sigma * g.sigma;
+        layer.phase_same = (2.0 * n + 1.0) * (g.sigma * same + s2 * bend_same);
+        layer.phase_orders =
+            layer.phase_same + (2.0 * n + 1.0) * (g.sigma * trip + 2.0 * s2 * bend);
+        hermite_nodes(layer.phase_same, NODE_TOLERANCE)?;
+        Some(layer)
+    }
+
+    /// `g(Δ)`, the coherence kept between orders `Δ` apart.
+    fn coherence(&self, delta: usize) -> f64 {
+        (-self.decay * (delta * delta) as f64).exp()
+    }
+
+    /// The fast group path `a = 2 Δ d ḡ` of `Δ` round trips.
+    fn fast(&self, delta: usize) -> f64 {
+        self.round_trip * delta as f64
+    }
+
+    /// Amplitudes at the complex node `z` (the continuation of `κ`). `None` if the order series
+    /// would not converge there.
+    fn at(&self, z: C64) -> Option<AtNode> {
+        let i = C64::new(0.0, 1.0);
+        // exp(i (z r_j + z² c_j/2)) and the continuation of its conjugate.
+        let ph: [C64; 4] = std::array::from_fn(|j| {
+            self.p[j] * (i * z * (self.residual[j] + 0.5 * z * self.curvature[j])).exp()
+        });
+        let ph_bar: [C64; 4] = std::array::from_fn(|j| {
+            self.p[j].conj()
+                * (-i * z * (self.residual[j].conj() + 0.5 * z * self.curvature[j])).exp()
+        });
+        let diag = |a: C64, b: C64| Matrix2::new(a, C64::new(0.0, 0.0), C64::new(0.0, 0.0), b);
+        let (pd, pu) = (diag(ph[0], ph[1]), diag(ph[2], ph[3]));
+        let (pdb, pub_) = (diag(ph_bar[0], ph_bar[1]), diag(ph_bar[2], ph_bar[3]));
+        let c = |m: &Matrix2<C64>| m.map(|z| z.conj());
+        let d = self.r3 * pu * self.r2 * pd;
+        let d_bar = c(&self.r3) * pub_ * c(&self.r2) * pdb;
+        if d.norm() * d_bar.norm() >= 1.0 {
+            return None;
+        }
+        Some(AtNode {
+            d,
+            d_bar,
+            x: self.t2 * pd,
+            x_bar: c(&self.t2) * pdb,
+            v: self.t3 * pu * self.r2 * pd,
+            v_bar: c(&self.t3) * pub_ * c(&self.r2) * pdb,
+        })
+    }
+}
+
+/// Smallest Gauss–Hermite rule integrating `exp(i x X)` to `tolerance` (error bound
+/// `(x²/2)ⁿ/n!`); `None` beyond [`MAX_NODES`].
+fn hermite_nodes(x: f64, tolerance: f64) -> Option<usize> {
+    let h = 0.5 * x * x;
+    let mut bound = 1.0;
+    for n in 1..=MAX_NODES {
+        bound *= h / n as f64;
+        if bound < tolerance {
+            return Some(n);
         }
     }
     None
+}
+
+/// `a ⊗ b`.
+fn kron(a: &Matrix2<C64>, b: &Matrix2<C64>) -> Matrix4<C64> {
+    a.kronecker(b)
+}
+
+/// `mⁿ`.
+fn power(m: &Matrix2<C64>, n: usize) -> Matrix2<C64> {
+    (0..n).fold(Matrix2::identity(), |acc, _| acc * m)
+}
+
+/// `S M S` with `S` the swap of the two Kronecker factors (indices 1 and 2 exchanged).
+fn swap(m: &Matrix4<C64>) -> Matrix4<C64> {
+    let p = [0, 2, 1, 3];
+    Matrix4::from_fn(|i, j| m[(p[i], p[j])])
 }

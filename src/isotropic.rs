@@ -1,0 +1,88 @@
+//! The isotropic fast path of [`crate::sampling::crystal_lobes`]: a lossless isotropic
+//! "crystal" (`η_o = η_e` real) is a dielectric interface, and its lobes follow in closed form
+//! (what Mitsuba's `dielectric` computes, here in this core's frames and conventions).
+//!
+//! Every wave of the event lies in one plane of incidence and its Jones basis is the s/p mode
+//! basis (`x = s`, `y = d × s`, [`crate::lobes`]), so each lobe's Jones matrix is diagonal: the
+//! Fresnel amplitudes of [`crate::fresnel`], flux-normalised (`τ = t √(w_far/w_near)`, the
+//! same factor for s and p in real-index media). Radiance mode needs the transfer from the
+//! source at `wo` into `wi`: for a lossless isotropic interface it is the same Mueller matrix
+//! (reflection: the same angle on the same side; transmission: reciprocity of the
+//! flux-normalised amplitudes, `τ(θ₁ → θ₂) = τ(θ₂ → θ₁)`), scaled by the radiance factor
+//! `(n_wi/n_wo)²` as in the general path.
+
+use crate::frame::PlaneFrame;
+use crate::fresnel::{normal_component, Fresnel};
+use crate::mueller;
+use crate::sampling::{PathLobe, Transport};
+use crate::surface::Surface;
+use nalgebra::Vector3;
+use num_complex::Complex64 as C64;
+
+/// The lobes seen from `wi` (unit, local, `wi.z ≠ 0`), or `None` if the fast path does not
+/// apply (an anisotropic or absorbing crystal).
+pub fn crystal_lobes(
+    surface: &Surface,
+    wi: Vector3<f64>,
+    transport: Transport,
+) -> Option<Vec<PathLobe>> {
+    let crystal = surface.crystal.eta_o;
+    if !surface.crystal.is_isotropic() || crystal.im != 0.0 {
+        return None;
+    }
+    let (ext, outside) = (surface.exterior.eta_o, wi.z > 0.0);
+    let (near, far) = if outside {
+        (ext, crystal)
+    } else {
+        (crystal, ext)
+    };
+    let beta = near * (wi.x * wi.x + wi.y * wi.y).sqrt();
+    let f = Fresnel::new(ext, crystal, beta)?;
+    let (r, t) = if outside {
+        (f.r_above, f.t_above)
+    } else {
+        (f.r_below, f.t_below)
+    };
+    let mut lobes = Vec::with_capacity(2);
+    let reflected = Vector3::new(-wi.x, -wi.y, wi.z);
+    lobes.push(lobe(0, wi, reflected, r, 1.0, transport));
+    let ratio = near.re / far.re;
+    let sin2 = ratio * ratio * (wi.x * wi.x + wi.y * wi.y);
+    if sin2 < 1.0 {
+        let cos = (1.0 - sin2).sqrt();
+        let wo = Vector3::new(-wi.x * ratio, -wi.y * ratio, -wi.z.signum() * cos);
+        let flux = (normal_component(far, beta).re / normal_component(near, beta).re).sqrt();
+        let tau = [t[0] * flux, t[1] * flux];
+        lobes.push(lobe(1, wi, wo, tau, far.re / near.re, transport));
+    }
+    Some(lobes)
+}
+
+/// One lobe with flux-normalised s/p amplitudes `a`; `n_ratio = n_wo / n_wi`.
+fn lobe(
+    component: usize,
+    wi: Vector3<f64>,
+    wo: Vector3<f64>,
+    a: [C64; 2],
+    n_ratio: f64,
+    transport: Transport,
+) -> PathLobe {
+    let m = mueller::from_diagonal(a[0].norm_sqr(), a[0].conj() * a[1], a[1].norm_sqr());
+    // The light arrives from `towards` (wi forward, wo by time reversal); its plane-of-incidence
+    // frame gives the s axis of every wave of the event.
+    let (towards, scale) = match transport {
+        Transport::Importance => (wi, 1.0),
+        Transport::Radiance => (wo, 1.0 / (n_ratio * n_ratio)),
+    };
+    let s = PlaneFrame::from_direction(towards).s;
+    let mueller = m * scale;
+    PathLobe {
+        component,
+        wo,
+        in_stokes_x: s,
+        out_stokes_x: s,
+        mueller,
+        weight: mueller[(0, 0)],
+        eta: n_ratio,
+    }
+}
