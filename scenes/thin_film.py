@@ -1,19 +1,19 @@
 """A thin birefringent film on glass, seen in reflection: iridescent thin-film colours.
 
 Scene 5 of the scene list (the seed's section 3, "Iridescence when reflecting off an anisotropic
-slab"): a uniaxial film with its optic axis in the film plane (ordinary index 1.51,
-extraordinary 1.69, constant: the order of magnitude of a stretched or liquid-crystal polymer
-film; illustrative values) lies on a glass substrate (`exit_ior` 1.5). Its thickness varies
-over the film like a draining soap film, from about 0.1 um at the top edge to 1.3 um at the
-bottom, with a slow swirl; the reflected colours run through the thin-film interference
-orders (Newton's colours), modified by the birefringence (the o and e waves have different
-optical thicknesses, so the colours depend on the azimuth of the light's plane of incidence
-relative to the optic axis).
+slab"): an x-cut lithium niobate film (the core's dispersive `linbo3`, n_o = 2.29, n_e = 2.20
+at 600 nm; optic axis in the film plane, along x) on fused silica (`exit_ior` 1.458), as in
+"lithium niobate on insulator" wafers. Its thickness varies over the object like a draining
+soap film, from 0.1 um at the top edge to `max_thickness_um` (0.8 um) at the bottom, with a
+slow swirl; the reflected colours run through the thin-film interference orders (Newton's
+colours), modified by the birefringence (the o and e waves have different optical
+thicknesses, so the colours depend on the azimuth of the plane of incidence relative to the
+optic axis).
 
 Geometry: the film is a 2 x 2 rectangle at z = 0 seen by a perspective camera 40 degrees from
 its normal; a large rectangular D65 area light sits at the camera's mirror position, so that
 every pixel sees the film's specular reflection of the light (radiance `light_scale` times D65,
-10 by default so that the film's few percent of reflectance give mid-grey pixels). Transmitted light leaves through
+3 by default so that the film's reflectance (about 5 to 30 %) gives mid-grey pixels). Transmitted light leaves through
 the substrate into empty space (a black background), so the image is the film's reflectance
 times the light: `thinbirefringent` with the whole plate (both interfaces and every internal
 reflection).
@@ -31,12 +31,12 @@ import numpy as np
 
 VARIANTS = ("scalar_rgb", "scalar_spectral", "scalar_spectral_polarized")
 
-#: Ordinary and extraordinary indices of the film (constant).
-ETA_O, ETA_E = 1.51, 1.69
-#: Substrate (glass) index.
-SUBSTRATE_IOR = 1.5
+#: The film's crystal (the core's catalogue).
+MATERIAL = "linbo3"
+#: Substrate index (fused silica, Mitsuba's "fused quartz").
+SUBSTRATE_IOR = 1.458
 #: Thickness range of the film (micrometres).
-MIN_THICKNESS_UM, MAX_THICKNESS_UM = 0.1, 1.3
+MIN_THICKNESS_UM, MAX_THICKNESS_UM = 0.1, 0.8
 
 
 def thickness_profile(n: int = 256) -> np.ndarray:
@@ -52,7 +52,7 @@ def thickness_profile(n: int = 256) -> np.ndarray:
 
 def scene(width: int = 256, height: int = 256, spp: int = 16, filter_bandwidth: float = 4.0,
           max_thickness_um: float = MAX_THICKNESS_UM, optic_axis=(1.0, 0.0, 0.0),
-          camera_angle_deg: float = 40.0, light_scale: float = 10.0) -> dict:
+          camera_angle_deg: float = 40.0, light_scale: float = 3.0) -> dict:
     """The scene as a dict for `mi.load_dict` (call `mi.set_variant` first)."""
     T = mi.ScalarTransform4f
     a = np.radians(camera_angle_deg)
@@ -79,8 +79,7 @@ def scene(width: int = 256, height: int = 256, spp: int = 16, filter_bandwidth: 
             "type": "rectangle",
             "bsdf": {
                 "type": "thinbirefringent",
-                "eta_o": ETA_O,
-                "eta_e": ETA_E,
+                "material": MATERIAL,
                 "ext_ior": 1.0,
                 "exit_ior": SUBSTRATE_IOR,
                 "optic_axis": list(optic_axis),

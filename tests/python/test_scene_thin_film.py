@@ -2,17 +2,18 @@
 (scalar_rgb) renders the same image as exact per-wavelength spectral sampling (scalar_spectral,
 filter_bandwidth 0) in the limit of many samples.
 
-Both sides render the same 12 x 12 image R = 12 times with independent seeds (scalar_rgb at
-16 spp: its only noise is the choice between the reflected and the transmitted lobe;
-scalar_spectral at 256 spp: that noise plus the sampled wavelengths). Per 3 x 3 block of pixels
-and per RGB channel (48 comparisons), the block means of the two sides are compared by Welch's
-statistic z = (mean_a - mean_b) / sqrt(se_a^2 + se_b^2); each mean is over 12 renders of 9
-pixels, so z is close to normal (about 20 degrees of freedom). Threshold: max |z| < 5, a
-family-wise false-alarm rate below 48 x P(|t_20| > 5) ~ 3e-3. The image mean of the two sides
-must also agree within 3 % (relative): the standard error of that difference is about 1 %
-(measured), and the only expected bias, the Gaussian fit of the CIE weights the core
-integrates over (validated to mean CIEDE2000 < 0.5 in tests/spectral_rgb.rs), is far below.
-A power check: the same statistic detects a 20 % change of the film's thickness.
+Both sides render the same 6 x 6 image R = 8 times with independent seeds (scalar_rgb at 8 spp:
+its only noise is the choice between the reflected and the transmitted lobe; scalar_spectral
+at 256 spp: that noise plus the sampled wavelengths). Per 2 x 2 block of pixels and per RGB
+channel (27 comparisons), the block means of the two sides are compared by Welch's statistic
+z = (mean_a - mean_b) / sqrt(se_a^2 + se_b^2), each mean over 8 renders (about 14 degrees of
+freedom). Threshold: max |z| < 5, a family-wise false-alarm rate below
+27 x P(|t_14| > 5) ~ 5e-3. The image means (all pixels and channels) of the two sides must
+also agree: the same statistic on them below 4 (one comparison, P(|t_14| > 4) ~ 1.3e-3); the
+only expected bias, the Gaussian fit of the CIE weights the core integrates over (validated to
+mean CIEDE2000 < 0.5 in tests/spectral_rgb.rs), is far below that resolution. A power check: the same statistic
+detects a 30 % change of the film's thickness. Small because scalar_rgb costs several ms per
+plate query on this dispersive film.
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ import numpy as np
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "scenes"))
 import thin_film  # noqa: E402
 
-SIZE, BLOCK, RENDERS, THRESHOLD = 12, 3, 12, 5.0
+SIZE, BLOCK, RENDERS, THRESHOLD = 6, 2, 8, 5.0
 
 
 def renders(variant: str, spp: int, **options) -> np.ndarray:
@@ -50,16 +51,17 @@ def test_variants_listed():
 
 
 def test_analytic_rgb_matches_converged_spectral():
-    rgb = renders("scalar_rgb", 16)
+    rgb = renders("scalar_rgb", 8)
     spectral = renders("scalar_spectral", 256, filter_bandwidth=0.0)
     z = max_z(rgb, spectral)
-    rel = abs(rgb.mean() / spectral.mean() - 1.0)
+    per_render = lambda x: x.reshape(RENDERS, -1).mean(axis=1)[:, None]
+    z_mean = max_z(per_render(rgb), per_render(spectral))
     print(f"thin film rgb vs spectral: max |z| = {z:.2f} over {rgb[0].size} block channels, "
-          f"image means {rgb.mean():.4f} / {spectral.mean():.4f} (relative difference {rel:.4f})")
+          f"image means {rgb.mean():.4f} / {spectral.mean():.4f} (z = {z_mean:.2f})")
     assert z < THRESHOLD
-    assert rel < 0.03
-    # Power: a film 20 % thinner shifts the interference colours; the same test must see it.
-    thinner = renders("scalar_rgb", 16, max_thickness_um=0.8 * thin_film.MAX_THICKNESS_UM)
+    assert z_mean < 4.0
+    # Power: a film 30 % thinner shifts the interference colours; the same test must see it.
+    thinner = renders("scalar_rgb", 8, max_thickness_um=0.7 * thin_film.MAX_THICKNESS_UM)
     z_thin = max_z(thinner, spectral)
-    print(f"power check (20 % thinner film): max |z| = {z_thin:.2f}")
+    print(f"power check (30 % thinner film): max |z| = {z_thin:.2f}")
     assert z_thin > THRESHOLD
