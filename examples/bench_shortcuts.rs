@@ -131,8 +131,13 @@ fn material(eta_o: f64, eta_e: f64) -> Material {
     Material::constant(C64::new(eta_o, 0.0), C64::new(eta_e, 0.0)).expect("valid indices")
 }
 
-#[allow(clippy::too_many_arguments)]
-fn query(m: Material, thickness_um: f64, axis: [f64; 3], want: Want, intensity: bool) -> PlateQuery {
+fn query(
+    m: Material,
+    thickness_um: f64,
+    axis: [f64; 3],
+    want: Want,
+    intensity: bool,
+) -> PlateQuery {
     PlateQuery::new(
         m,
         0.0,
@@ -148,11 +153,7 @@ fn query(m: Material, thickness_um: f64, axis: [f64; 3], want: Want, intensity: 
 }
 
 /// A closure evaluating `plate_lobes` of `q` over a band of `fwhm` around each input wavelength.
-fn plate_call(
-    q: PlateQuery,
-    fwhm: f64,
-    inputs: &[(Vector3<f64>, f64)],
-) -> impl FnMut(usize) + '_ {
+fn plate_call(q: PlateQuery, fwhm: f64, inputs: &[(Vector3<f64>, f64)]) -> impl FnMut(usize) + '_ {
     move |i| {
         let (wi, lambda) = inputs[i];
         let s = Spectrum::Band {
@@ -238,7 +239,6 @@ fn main() {
             .collect();
         // 0: Auto; 1: the coherent path sum; 2: quadrature panels.
         let run = |which: u8| {
-            let plate = plate;
             let inp = &inp;
             let (orders, panels) = (&orders, &panels);
             move |i: usize| {
@@ -294,8 +294,12 @@ fn main() {
     let surface = |eta_e: f64| {
         Surface::new(
             C64::new(1.0, 0.0),
-            Uniaxial::new(C64::new(1.5, 0.0), C64::new(eta_e, 0.0), Vector3::from(axis))
-                .unwrap(),
+            Uniaxial::new(
+                C64::new(1.5, 0.0),
+                C64::new(eta_e, 0.0),
+                Vector3::from(axis),
+            )
+            .unwrap(),
         )
         .unwrap()
     };
