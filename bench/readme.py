@@ -29,14 +29,30 @@ SHORTCUT_TEXT = {
 }
 
 
+def fmt_load(load) -> str:
+    return f"{load[0]:.2f}" if load else "n/a"
+
+
+def busy(m: dict) -> str:
+    """A warning when the load average exceeded the number of cores during the run."""
+    loads = [x[0] for x in (m.get("load_average_start"), m.get("load_average_end")) if x]
+    if loads and max(loads) > (m.get("logical_cores") or 1):
+        return (" (above the number of cores: other jobs shared the machine, so the times are "
+                "noisier and longer than on an idle one)")
+    return ""
+
+
 def section(r: dict) -> str:
     m = r["machine"]
     o = r["overhead_vs_mitsuba_by_variant"]
     s = r["settings"]["overhead"]
     lines = [
-        f"Measured by `make bench` on {r['date']}: {m['cpu']}, {m['logical_cores']} logical cores "
-        f"({m['system']}), Mitsuba {r['mitsuba']}; scene benchmark {r['bench_seconds'] / 60:.1f} min. "
-        "Figures from `bench/results.json` (details in `bench/out/`), written by `bench/readme.py`.",
+        f"Measured by `make bench-scenes` (the last step of `make bench`) on {r['date']}: {m['cpu']}, "
+        f"{m['logical_cores']} logical cores ({m['system']}), Mitsuba {r['mitsuba']}; scene benchmark "
+        f"{r['bench_seconds'] / 60:.1f} min; load average (1 min) {fmt_load(m.get('load_average_start'))} "
+        f"at the start and {fmt_load(m.get('load_average_end'))} at the end{busy(m)}. Figures from "
+        "`bench/results.json` (every measurement in `bench/out/scenes.json` and `shortcuts.json`, plots "
+        "`bench/out/error_vs_time-<scene>.png`), written by `bench/readme.py`.",
         "",
         f"**Render time against Mitsuba's own plugins** (same room scene, {s['size']}x{s['size']} px, "
         f"{s['spp']} spp, {s['integrator']}, isotropic parameters, median of {s['repeats']} interleaved renders; "

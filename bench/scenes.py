@@ -83,6 +83,14 @@ OVERHEAD_SIZE, OVERHEAD_SPP, OVERHEAD_REPEATS = 48, 8, 5
 OVERHEAD_VARIANTS = ("scalar_rgb", "scalar_spectral_polarized")
 
 
+def load_average() -> list[float] | None:
+    """1, 5 and 15 minute load averages (/proc/loadavg): how busy the machine was."""
+    try:
+        return [float(x) for x in open("/proc/loadavg", encoding="utf-8").read().split()[:3]]
+    except OSError:
+        return None
+
+
 def machine() -> dict:
     model, cores = "unknown", 0
     try:
@@ -400,6 +408,7 @@ def main() -> int:
     a.out.mkdir(parents=True, exist_ok=True)
     warnings.filterwarnings("ignore", module="colour")
     started = time.perf_counter()
+    load_before = load_average()
 
     modules = discover(a.scenes.split(",") if a.scenes else None)
     scenes = {name: error_vs_time(name, m, a.out) for name, m in modules.items()}
@@ -415,7 +424,7 @@ def main() -> int:
 
     results = {
         "date": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
-        "machine": machine(),
+        "machine": dict(machine(), load_average_start=load_before, load_average_end=load_average()),
         "mitsuba": mi.__version__,
         "overhead_vs_mitsuba": {"thinbirefringent": polarized["thinbirefringent"],
                                 "birefringent": polarized["birefringent"]},
