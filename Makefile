@@ -14,7 +14,12 @@
 #   make clean    removes build outputs (target/, out/, Python caches); keeps .venv/
 #   make distclean  clean, and removes .venv/ too
 #   make bench    make setup, then the core benchmark on one core (taskset -c 0) and its plot:
-#                 bench/out/core.json, bench/out/core_error_vs_time.png (several minutes)
+#                 bench/out/core.json, bench/out/core_error_vs_time.png (several minutes), then
+#                 make bench-scenes
+#   make bench-scenes  the scene benchmarks alone: the core's shortcuts (examples/bench_shortcuts.rs,
+#                 one core), error vs time per scene, overhead against Mitsuba's own plugins;
+#                 writes bench/results.json, bench/out/ (JSON, PNG plots) and README.md's
+#                 benchmark section (~10 min)
 
 SHELL := bash
 .SHELLFLAGS := -euo pipefail -c
@@ -57,7 +62,7 @@ MI_LDFLAGS = -shared -L$(SITE)/mitsuba -lmitsuba -L$(SITE)/drjit -ldrjit-core \
   -Wl,--exclude-libs,ALL -Wl,--gc-sections -Wl,--strip-debug -Wl,--no-undefined \
   -lpthread -ldl -lm
 
-.PHONY: help setup build venv plugin render test test-rust test-python bench fmt lint clean distclean
+.PHONY: help setup build venv plugin render test test-rust test-python bench bench-scenes fmt lint clean distclean
 
 help:
 	@sed -n '3,/^$$/s/^# \{0,1\}//p' $(firstword $(MAKEFILE_LIST))
@@ -150,6 +155,19 @@ bench: setup
 	@mkdir -p $(BENCH_OUT)
 	$(TASKSET) $(BENCH_BIN) --validate $(BENCH_PLATES) --out $(BENCH_OUT)/core.json
 	$(VPY) bench/plot_core.py $(BENCH_OUT)/core.json $(BENCH_OUT)/core_error_vs_time.png
+	$(MAKE) --no-print-directory bench-scenes
+
+# examples/bench_shortcuts.rs (speed ratios of the core's shortcuts, one core), then
+# bench/scenes.py (every scene module of scenes/: error vs time against an exact
+# per-wavelength reference, cached in bench/out/ by scene + parameters; render-time overhead
+# against Mitsuba's thindielectric/dielectric), which writes bench/results.json; then
+# bench/readme.py regenerates README.md between <!-- bench:begin --> and <!-- bench:end -->.
+bench-scenes: setup
+	$(CARGO) build --release --example bench_shortcuts
+	@mkdir -p $(BENCH_OUT)
+	$(TASKSET) target/release/examples/bench_shortcuts --out $(BENCH_OUT)/shortcuts.json
+	$(VPY) bench/scenes.py --out $(BENCH_OUT) --results bench/results.json
+	$(VPY) bench/readme.py bench/results.json README.md
 
 ## ---- code quality ----------------------------------------------------------------------
 

@@ -1,0 +1,451 @@
+#!/usr/bin/env python3
+"""Scene-level benchmarks (``make bench-scenes``; ``make bench`` runs it after the core benchmark).
+
+    .venv/bin/python bench/scenes.py [--out bench/out] [--results bench/results.json]
+                                     [--scenes a,b] [--repeats N] [--quick]
+
+Three parts, all measured here, in this process, with Mitsuba's default thread pool (every core
+of the machine; wall time of ``mi.render`` only, the scene loaded and rendered once beforehand):
+
+1. **Error vs time, per scene.** Every module of ``scenes/`` with ``scene`` and ``VARIANTS`` is
+   rendered small (``SIZES``). Its spectral variant is the first of ``VARIANTS`` whose name
+   contains "spectral". Reference: that variant with exact per-wavelength evaluation
+   (``filter_bandwidth = 0``) at ``REFERENCE_SPP`` samples per pixel, rendered in
+   ``REFERENCE_PASSES`` independent passes (their spread estimates the reference's own noise),
+   cached in ``bench/out/reference-<scene>-<hash>.npz``, the hash over the scene's source, the
+   render parameters, Mitsuba's version and the plugin library's bytes. Methods:
+   (a) ``exact``: the spectral variant, ``filter_bandwidth = 0``, at increasing spp;
+   (b) ``filter``: the same with the default 4 nm band;
+   (c) ``rgb``: ``scalar_rgb`` (the plate integrated in closed form over the sRGB channels), if
+   the scene's ``VARIANTS`` list it.
+   Errors against the reference: relative RMSE in linear RGB, ``sqrt(mean((x - r)^2) - v_r) /
+   sqrt(mean(r^2))`` with ``v_r`` the reference's own variance per pixel (estimated from its
+   passes; this removes the reference's noise from the estimate), and the mean CIEDE2000 over
+   pixels of the images converted linear sRGB -> XYZ (D65) -> CIE Lab with the white's Y = the
+   99th percentile of the reference's luminance (colour-science's implementations).
+   **At equal error**: for a point (t_m, e_m) of method (b) or (c), the time (a) needs to reach
+   e_m is interpolated linearly in (log e, log t) between the two points of curve (a) that
+   bracket e_m (extrapolated along the last (or first) segment of (a) when e_m lies outside its
+   measured range, and flagged ``extrapolated``); the ratio is t_a(e_m) / t_m. The scene's
+   headline figure is that ratio (mean CIEDE2000) at the method's highest-spp point whose error
+   lies within the range of (a), else at its highest-spp point (flagged).
+
+2. **Overhead against Mitsuba's own plugins**: a room (diffuse walls, ceiling light) with three
+   glass panes (``thinbirefringent`` eta_o = eta_e = 1.5, 1000 um, against ``thindielectric``
+   int_ior 1.5) or with a glass sphere and cube (``birefringent`` eta_o = eta_e = 1.5 against
+   ``dielectric`` int_ior 1.5), ``path`` with max_depth 8, same spp; in scalar_rgb and
+   scalar_spectral_polarized. All configurations of a variant are rendered in turn, ``repeats``
+   rounds (interleaved), with fresh seeds; figure = median time of ours / median time of
+   Mitsuba's. The same loop times the isotropic fast path at scene level: the same scenes with
+   eta_e = 1.5 + 1e-9 (optically identical, anisotropic to the core) against eta_e = 1.5, in
+   scalar_spectral_polarized.
+
+3. **Shortcuts**: the core-level ratios of ``examples/bench_shortcuts.rs`` (read from
+   ``bench/out/shortcuts.json``, which ``make bench-scenes`` writes first) plus the scene-level
+   isotropic ratios of part 2.
+
+Writes ``bench/results.json`` (the summary: ``overhead_vs_mitsuba``,
+``analytic_speedup_at_equal_error``, ``shortcuts``, the machine and the date),
+``bench/out/scenes.json`` (every measurement) and one PNG per scene
+(``bench/out/error_vs_time-<scene>.png``). ``bench/readme.py`` turns the results into the README
+section.
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime
+import hashlib
+import importlib
+import json
+import math
+import os
+import pathlib
+import platform
+import statistics
+import sys
+import time
+import warnings
+
+import numpy as np
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+SCENES_DIR = ROOT / "scenes"
+
+#: Image size per scene (small: the benchmark must stay within minutes); default for others.
+SIZES = {"michel_levy": (72, 24), "thin_film": (32, 32)}
+DEFAULT_SIZE = (32, 32)
+#: Samples per pixel of the curves, per method; the reference has REFERENCE_SPP.
+SPP = {"exact": (1, 4, 16, 64, 256), "filter": (2, 8, 32), "rgb": (1, 2, 4, 8, 16)}
+REFERENCE_SPP, REFERENCE_PASSES = 2048, 8
+#: Overhead scene: size, spp, rounds.
+OVERHEAD_SIZE, OVERHEAD_SPP, OVERHEAD_REPEATS = 48, 8, 5
+OVERHEAD_VARIANTS = ("scalar_rgb", "scalar_spectral_polarized")
+
+
+def load_average() -> list[float] | None:
+    """1, 5 and 15 minute load averages (/proc/loadavg): how busy the machine was."""
+    try:
+        return [float(x) for x in open("/proc/loadavg", encoding="utf-8").read().split()[:3]]
+    except OSError:
+        return None
+
+
+def machine() -> dict:
+    model, cores = "unknown", 0
+    try:
+        for line in open("/proc/cpuinfo", encoding="utf-8"):
+            if line.startswith("model name"):
+                model = line.split(":", 1)[1].strip()
+                cores += 1
+    except OSError:
+        pass
+    return {"cpu": model, "logical_cores": cores or os.cpu_count(), "system": platform.platform(),
+            "python": platform.python_version()}
+
+
+def set_variant(variant: str):
+    import mitsuba as mi
+
+    mi.set_variant(variant)
+    import mitsuba_birefringent  # noqa: F401  (registers the plugins for this variant)
+
+    return mi
+
+
+def discover(names: list[str] | None) -> dict:
+    """Scene modules of scenes/ that define `scene` and `VARIANTS`."""
+    sys.path.insert(0, str(SCENES_DIR))
+    import mitsuba as mi
+
+    mi.set_variant("scalar_rgb")  # scene modules import mitsuba at import time
+    found = {}
+    for path in sorted(SCENES_DIR.glob("*.py")):
+        if names and path.stem not in names:
+            continue
+        module = importlib.import_module(path.stem)
+        if callable(getattr(module, "scene", None)) and hasattr(module, "VARIANTS"):
+            found[path.stem] = module
+    return found
+
+
+def render(mi, scene, spp: int, seed: int) -> tuple[np.ndarray, float]:
+    start = time.perf_counter()
+    image = mi.render(scene, spp=spp, seed=seed)
+    seconds = time.perf_counter() - start
+    return np.array(image, dtype=np.float64)[..., :3], seconds
+
+
+def plugin_digest() -> str:
+    import mitsuba_birefringent
+
+    lib = pathlib.Path(mitsuba_birefringent.__file__).parent / "libmitsuba_birefringent.so"
+    return hashlib.sha256(lib.read_bytes()).hexdigest() if lib.exists() else "none"
+
+
+def reference(name: str, module, variant: str, size, out: pathlib.Path) -> dict:
+    mi = set_variant(variant)
+    key = json.dumps({"scene": name, "source": hashlib.sha256(
+        pathlib.Path(module.__file__).read_bytes()).hexdigest(), "variant": variant,
+        "size": size, "spp": REFERENCE_SPP, "passes": REFERENCE_PASSES,
+        "mitsuba": mi.__version__, "plugin": plugin_digest()}, sort_keys=True)
+    digest = hashlib.sha256(key.encode()).hexdigest()[:16]
+    cache = out / f"reference-{name}-{digest}.npz"
+    if cache.exists():
+        data = np.load(cache)
+        print(f"  reference: cached {cache.name}")
+        return {"mean": data["mean"], "var": data["var"], "seconds": float(data["seconds"]),
+                "cache": cache.name, "cached": True}
+    scene = mi.load_dict(module.scene(width=size[0], height=size[1], spp=REFERENCE_SPP,
+                                      filter_bandwidth=0.0))
+    spp = REFERENCE_SPP // REFERENCE_PASSES
+    passes, seconds = [], 0.0
+    for p in range(REFERENCE_PASSES):
+        img, dt = render(mi, scene, spp, seed=1_000_003 + p)
+        passes.append(img)
+        seconds += dt
+    passes = np.array(passes)
+    mean = passes.mean(axis=0)
+    var = passes.var(axis=0, ddof=1) / REFERENCE_PASSES  # variance of the mean, per pixel
+    np.savez(cache, mean=mean, var=var, seconds=seconds)
+    print(f"  reference: {REFERENCE_SPP} spp in {seconds:.1f} s -> {cache.name}")
+    return {"mean": mean, "var": var, "seconds": seconds, "cache": cache.name, "cached": False}
+
+
+def lab(rgb: np.ndarray, white_y: float) -> np.ndarray:
+    import colour
+
+    xyz = colour.RGB_to_XYZ(np.maximum(rgb, 0.0), "sRGB", apply_cctf_decoding=False)
+    illuminant = colour.CCS_ILLUMINANTS["CIE 1931 2 Degree Standard Observer"]["D65"]
+    return colour.XYZ_to_Lab(xyz / white_y, illuminant)
+
+
+def errors(img: np.ndarray, ref: dict) -> dict:
+    import colour
+
+    r = ref["mean"]
+    mse = float(np.mean((img - r) ** 2) - np.mean(ref["var"]))
+    rel_rmse = math.sqrt(max(mse, 0.0) / float(np.mean(r ** 2)))
+    y = r @ np.array([0.2126, 0.7152, 0.0722])
+    white = max(float(np.percentile(y, 99)), 1e-6)
+    de = colour.delta_E(lab(img, white), lab(r, white), method="CIE 2000")
+    return {"rel_rmse": rel_rmse, "mean_de2000": float(np.mean(de))}
+
+
+def curve_with(mi, module, size, spp_list, seed0, ref, **options) -> list[dict]:
+    scene = mi.load_dict(module.scene(width=size[0], height=size[1], spp=1, **options))
+    render(mi, scene, 1, seed=0)  # warm-up (first queries, caches)
+    rows = []
+    for k, spp in enumerate(spp_list):
+        img, seconds = render(mi, scene, spp, seed=seed0 + k)
+        row = {"spp": spp, "seconds": seconds, **errors(img, ref)}
+        print(f"    spp {spp:5d}: {seconds:8.2f} s  rel RMSE {row['rel_rmse']:.4f}  "
+              f"mean CIEDE2000 {row['mean_de2000']:.3f}")
+        rows.append(row)
+    return rows
+
+
+def time_at_error(exact: list[dict], metric: str, target: float) -> tuple[float, bool]:
+    """Time curve (a) needs to reach `target` (log-log interpolation; see the module doc)."""
+    pts = sorted((r["seconds"], r[metric]) for r in exact)
+    lt = [math.log(t) for t, _ in pts]
+    le = [math.log(max(e, 1e-12)) for _, e in pts]
+    x = math.log(max(target, 1e-12))
+    inside = min(le) <= x <= max(le)
+    best = None
+    for i in range(len(pts) - 1):
+        lo, hi = sorted((le[i], le[i + 1]))
+        if lo <= x <= hi and le[i] != le[i + 1]:
+            best = i
+            break
+    if best is None:  # extrapolate along the first or last segment
+        best = len(pts) - 2 if x < le[-1] else 0
+    i = best
+    if le[i + 1] == le[i]:
+        return math.exp(lt[i]), not inside
+    s = (lt[i + 1] - lt[i]) / (le[i + 1] - le[i])
+    return math.exp(lt[i] + s * (x - le[i])), not inside
+
+
+def equal_error(exact, method_rows, metric) -> list[dict]:
+    out = []
+    for r in method_rows:
+        t_a, extrapolated = time_at_error(exact, metric, r[metric])
+        out.append({"spp": r["spp"], "error": r[metric], "seconds": r["seconds"],
+                    "exact_seconds_at_error": t_a, "ratio": t_a / r["seconds"],
+                    "extrapolated": extrapolated})
+    return out
+
+
+def headline(ratios: list[dict]) -> dict:
+    inside = [r for r in ratios if not r["extrapolated"]]
+    pick = max(inside or ratios, key=lambda r: r["spp"])
+    return pick
+
+
+def plot(name: str, result: dict, path: pathlib.Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.4), dpi=110)
+    styles = {"exact": ("C0", "o", "(a) exact per wavelength (filter 0)"),
+              "filter": ("C1", "s", "(b) band filter 4 nm"),
+              "rgb": ("C3", "*", "(c) analytic RGB (scalar_rgb)")}
+    for ax, metric, label in ((axes[0], "mean_de2000", "mean CIEDE2000"),
+                              (axes[1], "rel_rmse", "relative RMSE (linear RGB)")):
+        for method, rows in result["curves"].items():
+            c, m, lab_ = styles[method]
+            ax.plot([r["seconds"] for r in rows], [max(r[metric], 1e-6) for r in rows],
+                    color=c, marker=m, label=lab_)
+            for r in rows:
+                ax.annotate(str(r["spp"]), (r["seconds"], max(r[metric], 1e-6)), fontsize=6,
+                            textcoords="offset points", xytext=(3, 3), color=c)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("render time (s, wall, all cores)")
+        ax.set_ylabel(label)
+        ax.grid(True, which="both", lw=0.3)
+    axes[0].legend(fontsize=7)
+    head = result.get("headline")
+    txt = (f"; {head['method']} at equal CIEDE2000: {head['ratio']:.3g}x less time"
+           + (" (extrapolated)" if head["extrapolated"] else "")) if head else ""
+    fig.suptitle(f"{name}: error vs time, {result['size'][0]}x{result['size'][1]} px, "
+                 f"{result['spectral_variant']}{txt}", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+
+
+def error_vs_time(name: str, module, out: pathlib.Path) -> dict:
+    size = SIZES.get(name, DEFAULT_SIZE)
+    spectral = next(v for v in module.VARIANTS if "spectral" in v)
+    print(f"{name}: {size[0]}x{size[1]} px, spectral variant {spectral}")
+    ref = reference(name, module, spectral, size, out)
+    mi = set_variant(spectral)
+    curves = {}
+    print("  (a) exact")
+    curves["exact"] = curve_with(mi, module, size, SPP["exact"], 100, ref, filter_bandwidth=0.0)
+    print("  (b) filter 4 nm")
+    curves["filter"] = curve_with(mi, module, size, SPP["filter"], 200, ref, filter_bandwidth=4.0)
+    if "scalar_rgb" in module.VARIANTS:
+        mi = set_variant("scalar_rgb")
+        print("  (c) scalar_rgb")
+        curves["rgb"] = curve_with(mi, module, size, SPP["rgb"], 300, ref)
+    ratios = {m: {metric: equal_error(curves["exact"], curves[m], metric)
+                  for metric in ("mean_de2000", "rel_rmse")}
+              for m in curves if m != "exact"}
+    method = "rgb" if "rgb" in curves else "filter"
+    h = dict(headline(ratios[method]["mean_de2000"]), method=method, metric="mean_de2000")
+    result = {"size": list(size), "spectral_variant": spectral,
+              "reference": {"spp": REFERENCE_SPP, "passes": REFERENCE_PASSES,
+                            "seconds": ref["seconds"], "cache": ref["cache"]},
+              "curves": curves, "equal_error": ratios, "headline": h}
+    print(f"  headline: {method} reaches mean CIEDE2000 {h['error']:.3f} in {h['seconds']:.2f} s; "
+          f"(a) needs {h['exact_seconds_at_error']:.2f} s: ratio {h['ratio']:.3g}"
+          + (" (extrapolated)" if h["extrapolated"] else ""))
+    plot(name, result, out / f"error_vs_time-{name}.png")
+    return result
+
+
+def room(mi, objects: dict) -> dict:
+    """A closed diffuse room with a ceiling light, and `objects`."""
+    T = mi.ScalarTransform4f
+    wall = lambda rgb: {"type": "diffuse", "reflectance": {"type": "rgb", "value": rgb}}
+    d = {
+        "type": "scene",
+        "integrator": {"type": "path", "max_depth": 8},
+        "sensor": {"type": "perspective", "fov": 50,
+                   "to_world": T().look_at(origin=[0, -3.4, 1.0], target=[0, 0, 0.9], up=[0, 0, 1]),
+                   "film": {"type": "hdrfilm", "width": OVERHEAD_SIZE, "height": OVERHEAD_SIZE,
+                            "rfilter": {"type": "box"}},
+                   "sampler": {"type": "independent", "sample_count": OVERHEAD_SPP}},
+        "floor": {"type": "rectangle", "to_world": T().scale(2), "bsdf": wall([0.7, 0.7, 0.7])},
+        "ceiling": {"type": "rectangle", "to_world": T().translate([0, 0, 2]).rotate([1, 0, 0], 180).scale(2),
+                    "bsdf": wall([0.7, 0.7, 0.7])},
+        "back": {"type": "rectangle", "to_world": T().translate([0, 2, 1]).rotate([1, 0, 0], 90).scale([2, 1, 1]),
+                 "bsdf": wall([0.6, 0.6, 0.6])},
+        "left": {"type": "rectangle", "to_world": T().translate([-2, 0, 1]).rotate([0, 1, 0], 90).scale([1, 2, 1]),
+                 "bsdf": wall([0.7, 0.2, 0.2])},
+        "right": {"type": "rectangle", "to_world": T().translate([2, 0, 1]).rotate([0, 1, 0], -90).scale([1, 2, 1]),
+                  "bsdf": wall([0.2, 0.6, 0.2])},
+        "lamp": {"type": "rectangle", "to_world": T().translate([0, 0, 1.99]).rotate([1, 0, 0], 180).scale(0.5),
+                 "emitter": {"type": "area", "radiance": {"type": "d65", "scale": 8.0}}},
+    }
+    d.update(objects)
+    return d
+
+
+def panes(mi, bsdf: dict) -> dict:
+    T = mi.ScalarTransform4f
+    return {f"pane{i}": {"type": "rectangle", "bsdf": bsdf,
+                         "to_world": T().translate([x, y, 0.8]).rotate([0, 0, 1], a).rotate([1, 0, 0], 90).scale([0.5, 0.7, 1])}
+            for i, (x, y, a) in enumerate(((-0.9, 0.3, 20), (0.0, -0.4, -10), (0.9, 0.5, 35)))}
+
+
+def solids(mi, bsdf: dict) -> dict:
+    T = mi.ScalarTransform4f
+    return {"sphere": {"type": "sphere", "center": [-0.6, 0.0, 0.6], "radius": 0.55, "bsdf": bsdf},
+            "cube": {"type": "cube", "bsdf": bsdf,
+                     "to_world": T().translate([0.7, 0.3, 0.45]).rotate([0, 0, 1], 30).scale(0.42)}}
+
+
+def overhead(repeats: int) -> dict:
+    thin = lambda e: {"type": "thinbirefringent", "eta_o": 1.5, "eta_e": e, "ext_ior": 1.0,
+                      "thickness": 1000.0}
+    bulk = lambda e: {"type": "birefringent", "eta_o": 1.5, "eta_e": e, "ext_ior": 1.0}
+    configs = {
+        "thindielectric": lambda mi: panes(mi, {"type": "thindielectric", "int_ior": 1.5, "ext_ior": 1.0}),
+        "thinbirefringent": lambda mi: panes(mi, thin(1.5)),
+        "thinbirefringent_aniso": lambda mi: panes(mi, thin(1.5 + 1e-9)),
+        "dielectric": lambda mi: solids(mi, {"type": "dielectric", "int_ior": 1.5, "ext_ior": 1.0}),
+        "birefringent": lambda mi: solids(mi, bulk(1.5)),
+        "birefringent_aniso": lambda mi: solids(mi, bulk(1.5 + 1e-9)),
+    }
+    out = {}
+    for variant in OVERHEAD_VARIANTS:
+        mi = set_variant(variant)
+        scenes = {}
+        for name, objects in configs.items():
+            if name.endswith("_aniso") and "polarized" not in variant:
+                continue  # an anisotropic bulk crystal needs a polarised variant; the thin
+                # plate's scene-level shortcut is timed in the polarised variant only
+            scenes[name] = mi.load_dict(room(mi, objects(mi)))
+            mi.render(scenes[name], spp=1, seed=0)  # warm-up
+        times = {name: [] for name in scenes}
+        for rep in range(repeats):
+            for name, scene in scenes.items():
+                times[name].append(render(mi, scene, OVERHEAD_SPP, seed=10 * rep + 1)[1])
+        med = {name: statistics.median(t) for name, t in times.items()}
+        ratios = {"thinbirefringent": med["thinbirefringent"] / med["thindielectric"],
+                  "birefringent": med["birefringent"] / med["dielectric"]}
+        if "birefringent_aniso" in med:
+            ratios["isotropic_fast_path_thin"] = med["thinbirefringent_aniso"] / med["thinbirefringent"]
+            ratios["isotropic_fast_path_bulk"] = med["birefringent_aniso"] / med["birefringent"]
+        print(f"overhead, {variant}: " + ", ".join(f"{k} {v:.2f} s" for k, v in med.items()))
+        print("  ratios: " + ", ".join(f"{k} {v:.3f}" for k, v in ratios.items()))
+        out[variant] = {"median_seconds": med, "seconds": times, "ratios": ratios}
+    return out
+
+
+def main() -> int:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--out", type=pathlib.Path, default=ROOT / "bench" / "out")
+    p.add_argument("--results", type=pathlib.Path, default=ROOT / "bench" / "results.json")
+    p.add_argument("--shortcuts", type=pathlib.Path, default=None,
+                   help="JSON of examples/bench_shortcuts.rs (default OUT/shortcuts.json)")
+    p.add_argument("--scenes", default=None, help="comma-separated scene names (default: all)")
+    p.add_argument("--repeats", type=int, default=OVERHEAD_REPEATS)
+    p.add_argument("--quick", action="store_true",
+                   help="tiny budgets to check that the script runs (figures meaningless)")
+    a = p.parse_args()
+    if a.quick:
+        global SPP, REFERENCE_SPP, REFERENCE_PASSES, OVERHEAD_SIZE, OVERHEAD_SPP
+        SPP = {"exact": (2, 4, 8), "filter": (2, 4), "rgb": (1, 2)}
+        REFERENCE_SPP, REFERENCE_PASSES, OVERHEAD_SIZE, OVERHEAD_SPP = 64, 4, 16, 2
+        a.repeats = 1
+    a.out.mkdir(parents=True, exist_ok=True)
+    warnings.filterwarnings("ignore", module="colour")
+    started = time.perf_counter()
+    load_before = load_average()
+
+    modules = discover(a.scenes.split(",") if a.scenes else None)
+    scenes = {name: error_vs_time(name, m, a.out) for name, m in modules.items()}
+    over = overhead(a.repeats)
+    shortcuts_path = a.shortcuts or a.out / "shortcuts.json"
+    core_shortcuts = json.loads(shortcuts_path.read_text()) if shortcuts_path.exists() else None
+
+    polarized = over["scalar_spectral_polarized"]["ratios"]
+    shortcuts = dict(core_shortcuts["headline"]) if core_shortcuts else {}
+    shortcuts["isotropic_fast_path_scene_thin"] = polarized["isotropic_fast_path_thin"]
+    shortcuts["isotropic_fast_path_scene_bulk"] = polarized["isotropic_fast_path_bulk"]
+    import mitsuba as mi
+
+    results = {
+        "date": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+        "machine": dict(machine(), load_average_start=load_before, load_average_end=load_average()),
+        "mitsuba": mi.__version__,
+        "overhead_vs_mitsuba": {"thinbirefringent": polarized["thinbirefringent"],
+                                "birefringent": polarized["birefringent"]},
+        "overhead_vs_mitsuba_by_variant": {v: {k: over[v]["ratios"][k]
+                                               for k in ("thinbirefringent", "birefringent")}
+                                           for v in over},
+        "analytic_speedup_at_equal_error": {n: r["headline"]["ratio"] for n, r in scenes.items()},
+        "equal_error_detail": {n: r["headline"] for n, r in scenes.items()},
+        "shortcuts": shortcuts,
+        "settings": {"overhead": {"size": OVERHEAD_SIZE, "spp": OVERHEAD_SPP,
+                                  "repeats": a.repeats, "integrator": "path, max_depth 8"},
+                     "reference_spp": REFERENCE_SPP, "spp": SPP,
+                     "sizes": {n: list(SIZES.get(n, DEFAULT_SIZE)) for n in scenes}},
+        "bench_seconds": time.perf_counter() - started,
+    }
+    detail = {"scenes": scenes, "overhead": over, "core_shortcuts": core_shortcuts}
+    (a.out / "scenes.json").write_text(json.dumps(detail, indent=1))
+    a.results.write_text(json.dumps(results, indent=2) + "\n")
+    print(f"wrote {a.results} and {a.out / 'scenes.json'} in {results['bench_seconds']:.0f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
