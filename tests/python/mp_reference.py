@@ -306,3 +306,61 @@ def k_max_e(eta_o, eta_e, axis):
         else:
             hi = mid
     return lo
+
+
+def slab(case):
+    """Reference plate (calculator `slab` input: thickness_um, exit_ior; outside incidence) at
+    one wavelength: the eight unknown amplitudes (reflected s, p at z = 0; the crystal's two
+    down-going waves referenced at z = 0 and two up-going waves referenced at z = -d; the exit
+    medium's s, p referenced at z = -d) from the continuity of tangential E and H at both
+    faces, one 8x8 system per input polarisation, solved at 50 digits. Referencing every wave
+    where it enters the layer keeps every propagation factor exp(i k0 q dz) of modulus <= 1.
+    Returns R[in+out], T[in+out] power fractions and the flux-normalised Jones matrices
+    J_R, J_T (rows: output s, p; columns: input s, p)."""
+    n1 = mpc_of(case.get("ext_ior", 1.0))
+    n3 = mpc_of(case.get("exit_ior", case.get("ext_ior", 1.0)))
+    eta_o, eta_e = mpc_of(case["eta_o"]), mpc_of(case["eta_e"])
+    frame = working_frame(case.get("phi_deg", 0.0))
+    a_local = [mp.mpf(x) for x in case["optic_axis"]]
+    na = mp.sqrt(sum(x * x for x in a_local))
+    a_local = [x / na for x in a_local]
+    u, s = frame
+    axis = [mp.mpc(sum(a_local[i] * u[i] for i in range(3))),
+            mp.mpc(sum(a_local[i] * s[i] for i in range(3))), mp.mpc(a_local[2])]
+    beta = mpc_of(case["beta"])
+    k0d = 2 * mp.pi * mp.mpf(case["thickness_um"]) * 1000 / mp.mpf(case["wavelength_nm"])
+    top_down, top_up = isotropic_waves(n1, beta)
+    cr_down, cr_up = crystal_waves(eta_o, eta_e, axis, beta)
+    ex_down, _ = isotropic_waves(n3, beta)
+    i = mp.mpc(0, 1)
+    pd = [mp.exp(-i * w.q * k0d) for w in cr_down]  # down wave from z = 0 to z = -d
+    pu = [mp.exp(i * w.q * k0d) for w in cr_up]     # up wave from z = -d to z = 0
+    # Unknowns x = [r_s, r_p, a_1, a_2, b_1, b_2, t_s, t_p].
+    a = mp.matrix(8, 8)
+    for row in range(4):
+        # z = 0: incident + r_s, r_p (top) = a (crystal down) + b exp(i q_up d) (crystal up)
+        a[row, 0] = top_up[0].tangential()[row]
+        a[row, 1] = top_up[1].tangential()[row]
+        for k in range(2):
+            a[row, 2 + k] = -cr_down[k].tangential()[row]
+            a[row, 4 + k] = -cr_up[k].tangential()[row] * pu[k]
+        # z = -d: a exp(-i q_down d) + b = t (exit down)
+        for k in range(2):
+            a[4 + row, 2 + k] = cr_down[k].tangential()[row] * pd[k]
+            a[4 + row, 4 + k] = cr_up[k].tangential()[row]
+            a[4 + row, 6 + k] = -ex_down[k].tangential()[row]
+    R, T = {}, {}
+    jr = [[None, None], [None, None]]
+    jt = [[None, None], [None, None]]
+    ex_flux = [abs(w.flux) if abs(mp.im(w.q)) < mp.mpf(10) ** -30 or mp.im(n3) != 0 else 0
+               for w in ex_down]
+    for c, inc in enumerate(top_down):
+        rhs = mp.matrix([-v for v in inc.tangential()] + [0, 0, 0, 0])
+        x = mp.lu_solve(a, rhs)
+        pin = abs(inc.flux)
+        for o in range(2):
+            R["sp"[c] + "sp"[o]] = abs(x[o]) ** 2 * abs(top_up[o].flux) / pin
+            T["sp"[c] + "sp"[o]] = abs(x[6 + o]) ** 2 * ex_flux[o] / pin
+            jr[o][c] = x[o]
+            jt[o][c] = x[6 + o] * mp.sqrt(ex_flux[o] / pin)
+    return {"R": R, "T": T, "jones_R": jr, "jones_T": jt}
