@@ -115,16 +115,26 @@ impl Interface {
         })
     }
 
-    /// `|P|` of the outgoing waves `[up₁, down₂]`.
+    /// `|P|` of the outgoing waves `[up₁, down₂]` (0 for an evanescent wave).
     pub fn outgoing_flux(&self) -> [f64; 4] {
         let (u, d) = (&self.upper.up, &self.lower.down);
-        [u[0], u[1], d[0], d[1]].map(|m| m.flux().abs())
+        [&u[0], &u[1], &d[0], &d[1]].map(carried)
     }
 
-    /// `|P|` of the incoming waves `[down₁, up₂]`.
+    /// `|P|` of the incoming waves `[down₁, up₂]` (0 for an evanescent wave: its flux is
+    /// rounding noise, and dividing by it would give meaningless power ratios).
     pub fn incoming_flux(&self) -> [f64; 4] {
         let (d, u) = (&self.upper.down, &self.lower.up);
-        [d[0], d[1], u[0], u[1]].map(|m| m.flux().abs())
+        [&d[0], &d[1], &u[0], &u[1]].map(carried)
+    }
+}
+
+/// The power a mode carries through the surface: `|P|`, or 0 if it is evanescent.
+fn carried(m: &Mode) -> f64 {
+    if m.is_evanescent() {
+        0.0
+    } else {
+        m.flux().abs()
     }
 }
 

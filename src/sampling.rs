@@ -92,12 +92,20 @@ fn outgoing(event: &Event, incident: Option<ModeKind>) -> Vec<(usize, Option<Mod
 }
 
 /// Lobes of a bulk crystal surface seen from `wi` (unit, local; `wi.z < 0` is inside). A
-/// lossless isotropic crystal takes the closed form of [`crate::isotropic`].
+/// lossless isotropic crystal takes the closed form of [`crate::isotropic`]. Absorbing
+/// anisotropic crystals are refused (an error naming `kappa`): their per-ray powers are not
+/// defined (see the error message); isotropic absorbing media (metals) are fine.
 pub fn crystal_lobes(
     surface: &Surface,
     wi: Vector3<f64>,
     transport: Transport,
 ) -> Result<Vec<PathLobe>> {
+    if !surface.crystal.is_isotropic() && !surface.crystal.is_lossless() {
+        return Err(Error::new(
+            "kappa",
+            "an absorbing birefringent crystal cannot be rendered as a bulk surface: inside it the o and e waves are not power-orthogonal (their fluxes do not add), so the power of each refracted ray is undefined and lobe weights would not conserve energy. Use thinbirefringent for a dichroic plate (its transmission is exact), or kappa_o = kappa_e = 0 here",
+        ));
+    }
     let Some(wi) = checked_direction(wi)? else {
         return Ok(Vec::new());
     };

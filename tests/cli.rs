@@ -241,3 +241,15 @@ fn slab_errors_name_the_field() {
     assert_eq!(code, 1);
     assert!(out.contains("thickness_um"), "{out}");
 }
+
+/// An e-wave from inside past its K_max is evanescent: it carries no power, so the calculator
+/// refuses the case instead of dividing by a rounding-level flux (which once printed R = 5.6e15).
+#[test]
+fn an_evanescent_incident_wave_is_refused() {
+    let case = r#"{"wavelength_nm":550,"ext_ior":1.0,"eta_o":1.5,"eta_e":1.0001,"optic_axis":[0.3,0.2,0.5],"beta":1.2,"side":"inside","inside_mode":"e"}"#;
+    let (code, out) = run(&["interface"], case);
+    assert_ne!(code, 0);
+    let v: Value = serde_json::from_str(&out).unwrap();
+    let e = v["error"].as_str().unwrap();
+    assert!(e.starts_with("incidence:") && e.contains("no power"), "{e}");
+}

@@ -8,8 +8,8 @@
 
 use birefringent::ffi::{
     bfr_crystal_lobes, bfr_material_free, bfr_material_new, bfr_plate_lobes, BfrComplex,
-    BfrGeometry, BfrMaterialDesc, BfrPathLobe, BFR_CRYSTAL_LOBES, BFR_IMPORTANCE, BFR_OK,
-    BFR_RADIANCE, BFR_WANT_REFLECTION, BFR_WANT_TRANSMISSION,
+    BfrGeometry, BfrMaterialDesc, BfrPathLobe, BFR_CRYSTAL_LOBES, BFR_IMPORTANCE, BFR_INVALID,
+    BFR_OK, BFR_RADIANCE, BFR_WANT_REFLECTION, BFR_WANT_TRANSMISSION,
 };
 use birefringent::frame::PlaneFrame;
 use birefringent::interface::Interface;
@@ -639,6 +639,7 @@ fn c_abi_with_f32_inputs_as_the_shim_passes_them() {
     let mut lossless_sum_err = 0.0f64;
     let mut slowest = 0.0f64;
     let mut negative_eta = 0usize;
+    let mut refused = 0usize;
     let (mut worst_band, mut worst_band_case) = (0.0f64, String::new());
     let (mut unbounded, mut max_unbounded) = (0usize, [0.0f64; 2]);
     let (mut worst_sum_case, mut slowest_case) = (String::new(), String::new());
@@ -720,53 +721,64 @@ fn c_abi_with_f32_inputs_as_the_shim_passes_them() {
             let text = unsafe { std::ffi::CStr::from_ptr(msg.as_ptr()) }
                 .to_string_lossy()
                 .into_owned();
-            assert_eq!(
-                rc, BFR_OK,
-                "crystal: {text} desc {desc:?} g {g:?} wi {wi:?} lambda {lambda}"
-            );
-            let mut sum = 0.0;
-            // Absorbing crystals: the per-wave power fractions leave out the interference terms
-            // of the flux (o with e below the surface; incident with reflected inside), so
-            // their sum has no bound (see `balance`); measured and reported, not asserted.
-            let bounded = transport == BFR_IMPORTANCE && lossless;
-            for l in out.iter().filter(|l| l.exists == 1) {
-                let mm = Matrix4::from_row_slice(&l.mueller);
-                let bound = if bounded { 1.0 + 1e-9 } else { f64::INFINITY };
-                worst_mueller = worst_mueller.max(mueller_violation(&mm, bound));
-                assert!(
-                    l.weight >= 0.0 && l.eta.is_finite() && l.eta != 0.0,
-                    "lobe {l:?}"
+            // An absorbing birefringent crystal is refused as a bulk surface (its per-ray powers
+            // are undefined): a clear error naming kappa, never lobes.
+            let isotropic =
+                !named && desc.eta_o.re == desc.eta_e.re && desc.kappa_o == desc.kappa_e;
+            if !lossless && !isotropic && (desc.kappa_o > 0.0 || desc.kappa_e > 0.0) {
+                assert_eq!(rc, BFR_INVALID, "absorbing crystal accepted: {desc:?}");
+                assert!(text.starts_with("kappa:"), "{text}");
+                refused += 1;
+            } else {
+                assert_eq!(
+                    rc, BFR_OK,
+                    "crystal: {text} desc {desc:?} g {g:?} wi {wi:?} lambda {lambda}"
                 );
-                // bs.eta is a ratio of ray indices (seed eq. S14): positive for lossless media.
-                // In strongly absorbing crystals the core's ray index Re(η_ef) ⟨W, ray⟩ can be
-                // negative (the Poynting vector more than 90° from Re k); counted and reported.
-                if l.eta < 0.0 {
+                let mut sum = 0.0;
+                // Absorbing crystals: the per-wave power fractions leave out the interference terms
+                // of the flux (o with e below the surface; incident with reflected inside), so
+                // their sum has no bound (see `balance`); measured and reported, not asserted.
+                let bounded = transport == BFR_IMPORTANCE && lossless;
+                for l in out.iter().filter(|l| l.exists == 1) {
+                    let mm = Matrix4::from_row_slice(&l.mueller);
+                    let bound = if bounded { 1.0 + 1e-9 } else { f64::INFINITY };
+                    worst_mueller = worst_mueller.max(mueller_violation(&mm, bound));
                     assert!(
-                        desc.kappa_o > 0.0 || desc.kappa_e > 0.0,
-                        "eta < 0, lossless: {l:?}"
+                        l.weight >= 0.0 && l.eta.is_finite() && l.eta != 0.0,
+                        "lobe {l:?}"
                     );
-                    negative_eta += 1;
-                    if negative_eta == 1 {
-                        let name = if named { NAMED[idx].0 } else { "constant" };
-                        println!("C ABI: first eta < 0: {name} {desc:?} {g:?} wi {wi:?} lambda {lambda} transport {transport}: {l:?}");
+                    // bs.eta is a ratio of ray indices (seed eq. S14): positive for lossless media.
+                    // In strongly absorbing crystals the core's ray index Re(η_ef) ⟨W, ray⟩ can be
+                    // negative (the Poynting vector more than 90° from Re k); counted and reported.
+                    if l.eta < 0.0 {
+                        assert!(
+                            desc.kappa_o > 0.0 || desc.kappa_e > 0.0,
+                            "eta < 0, lossless: {l:?}"
+                        );
+                        negative_eta += 1;
+                        if negative_eta == 1 {
+                            let name = if named { NAMED[idx].0 } else { "constant" };
+                            println!("C ABI: first eta < 0: {name} {desc:?} {g:?} wi {wi:?} lambda {lambda} transport {transport}: {l:?}");
+                        }
                     }
+                    sum += l.weight;
                 }
-                sum += l.weight;
-            }
-            if transport == BFR_IMPORTANCE && !bounded {
-                if sum > 1.0 + 1e-9 {
-                    unbounded += 1;
+                if transport == BFR_IMPORTANCE && !bounded {
+                    if sum > 1.0 + 1e-9 {
+                        unbounded += 1;
+                    }
+                    let k = usize::from(wi[2] < 0.0);
+                    max_unbounded[k] = max_unbounded[k].max(sum);
                 }
-                let k = usize::from(wi[2] < 0.0);
-                max_unbounded[k] = max_unbounded[k].max(sum);
-            }
-            if bounded {
-                if sum - 1.0 > worst_sum {
-                    worst_sum = sum - 1.0;
-                    worst_sum_case = format!("crystal {desc:?} {g:?} wi {wi:?} lambda {lambda}");
-                }
-                if lossless && !named && wi[2] > 0.0 && theta < 1.5 {
-                    lossless_sum_err = lossless_sum_err.max((sum - 1.0).abs());
+                if bounded {
+                    if sum - 1.0 > worst_sum {
+                        worst_sum = sum - 1.0;
+                        worst_sum_case =
+                            format!("crystal {desc:?} {g:?} wi {wi:?} lambda {lambda}");
+                    }
+                    if lossless && !named && wi[2] > 0.0 && theta < 1.5 {
+                        lossless_sum_err = lossless_sum_err.max((sum - 1.0).abs());
+                    }
                 }
             }
             // The band-filtered plate is evaluated only where (n_e − n_o) d <= 20 µm: beyond, a
@@ -842,7 +854,8 @@ fn c_abi_with_f32_inputs_as_the_shim_passes_them() {
         // SAFETY: created above, not used afterwards.
         unsafe { bfr_material_free(m) };
     }
-    println!("C ABI: {calls} calls, all BFR_OK; worst Mueller violation {worst_mueller:.3e}");
+    println!("C ABI: {calls} calls, all BFR_OK but {refused} absorbing bulk crystals refused as asked; worst Mueller violation {worst_mueller:.3e}");
+    assert!(refused > 100);
     println!(
         "C ABI: slowest plate call {:.3} ms ({slowest_case})",
         slowest * 1e3
@@ -852,10 +865,10 @@ fn c_abi_with_f32_inputs_as_the_shim_passes_them() {
         "C ABI: band-filtered plate (4 nm), worst R + T - 1 = {worst_band:.3e} ({worst_band_case})"
     );
     println!(
-        "C ABI: absorbing crystals, Importance: {unbounded} calls with sum of weights > 1, largest {:.3} from outside, {:.3} from inside",
+        "C ABI: absorbing isotropic media, Importance: {unbounded} calls with sum of weights > 1, largest {:.3} from outside, {:.3} from inside",
         max_unbounded[0], max_unbounded[1]
     );
-    println!("C ABI: lobes with eta < 0 (absorbing crystals only): {negative_eta}");
+    println!("C ABI: lobes with eta < 0 (absorbing media only): {negative_eta}");
     println!("C ABI: Importance mode, worst sum of weights - 1 = {worst_sum:.3e}");
     println!("C ABI: lossless crystal from outside (theta < 1.5 rad): worst |sum - 1| = {lossless_sum_err:.3e}");
     assert!(worst_mueller <= 1e-12, "{worst_mueller:e}");

@@ -212,8 +212,8 @@ fn require_flux(flux: f64) -> Result<()> {
         Ok(())
     } else {
         Err(Error::new(
-            "theta_deg",
-            "the incident wave carries no power through the surface (grazing or evanescent)",
+            "incidence",
+            "the incident wave carries no power through the surface (grazing, or evanescent past K_max)",
         ))
     }
 }
