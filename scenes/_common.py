@@ -47,7 +47,7 @@ def data_texture(values: np.ndarray, filter_type: str = "bilinear") -> dict:
     }
 
 
-def monochromatic_srf(wavelength_nm: float, width_nm: float = 0.1) -> dict:
+def monochromatic_srf(wavelength_nm: float, width_nm: float = 0.01) -> dict:
     """A sensor response that is non-zero only within +-width/2 of `wavelength_nm`: spectral
     variants then sample every wavelength of a path inside that band (a monochromatic camera)."""
     return {

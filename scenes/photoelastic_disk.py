@@ -83,7 +83,7 @@ def scene(width: int = 512, height: int = 512, spp: int = 16, filter_bandwidth: 
           max_fringe_order: float = 60.0, crop: tuple[int, int, int, int] | None = None) -> dict:
     """The scene as a dict for `mi.load_dict` (scalar_spectral_polarized).
 
-    `wavelength_nm` makes the camera monochromatic (one channel: the radiance in a 0.1 nm band);
+    `wavelength_nm` makes the camera monochromatic (one channel: the radiance in a 0.01 nm band);
     `max_fringe_order` (at 550 nm) clips the stress next to the loads; `crop` = (offset_x,
     offset_y, width, height) renders only that window of the width x height image.
     """
