@@ -78,8 +78,10 @@ def ortho_sensor(width: int, height: int, spp: int, half_x: float, half_y: float
                      "crop_height": crop[3]})
     sensor = {
         "type": "orthographic",
+        # Mitsuba's orthographic camera sees [-1, 1] x [-1/aspect, 1/aspect] in its own frame
+        # (aspect = width / height): scale y by the aspect to see +-half_y.
         "to_world": T().look_at(origin=[0, 0, z], target=[0, 0, 0], up=[0, 1, 0])
-        @ T().scale([half_x, half_y, 1.0]),
+        @ T().scale([half_x, half_y * width / height, 1.0]),
         "film": film,
         "sampler": {"type": "independent", "sample_count": spp},
     }
