@@ -18,9 +18,9 @@ o wave is polarised perpendicular to the principal plane (the plane of the norma
 the e wave in it, so a polariser transmitting along the axis azimuth passes the e image and
 extinguishes the o image, and one at 90 degrees to it does the reverse.
 
-The check (tests/python/test_scene_calcite_rhomb.py): the offset between the two images, measured
-by cross-correlation with the text, against the closed form; each polariser angle extinguishes
-the right image.
+The check (tests/python/test_scene_calcite_rhomb.py): in a monochromatic render the offset
+between the two images, measured by cross-correlation with the text, against the closed form;
+each polariser angle extinguishes the right image.
 
 Variant: scalar_spectral_polarized (the Stokes vector tells o from e rays in the crystal). The
 light box is equal-energy white (the text bitmap is a raw grey-level radiance).
@@ -78,12 +78,13 @@ def walk_off_deg(n_o: float, n_e: float, tilt_deg: float) -> float:
 
 def scene(width: int = 360, height: int = 240, spp: int = 32, filter_bandwidth: float = 4.0,
           thickness: float = 1.2, axis_tilt_deg: float = 44.6, axis_azimuth_deg: float = 30.0,
-          polarizer_deg: float | None = None) -> dict:
+          polarizer_deg: float | None = None, wavelength_nm: float | None = None) -> dict:
     """The scene as a dict for `mi.load_dict` (scalar_spectral_polarized).
 
     `polarizer_deg`: None = no polariser; otherwise the transmission axis of a polariser on the
-    block (counter-clockwise from x, seen from the camera). `filter_bandwidth` is unused (there
-    is no thin plate), accepted for the common scene interface.
+    block (counter-clockwise from x, seen from the camera). `wavelength_nm` makes the camera
+    monochromatic (one channel, a 0.01 nm band): no dispersion of the walk-off.
+    `filter_bandwidth` is unused (there is no thin plate), accepted for the common interface.
     """
     del filter_bandwidth
     if not TEXT_BITMAP.exists():
@@ -93,7 +94,7 @@ def scene(width: int = 360, height: int = 240, spp: int = 32, filter_bandwidth: 
     d = {
         "type": "scene",
         "integrator": {"type": "path", "max_depth": 12},
-        "sensor": ortho_sensor(width, height, spp, VIEW_X, VIEW_Y),
+        "sensor": ortho_sensor(width, height, spp, VIEW_X, VIEW_Y, wavelength_nm=wavelength_nm),
         # The PNG's top row is the sheet's top edge: to_uv flips v (a bitmap's row 0 is at v = 0,
         # the rectangle's bottom edge).
         "sheet": {
