@@ -16,6 +16,8 @@ from __future__ import annotations
 import mitsuba as mi
 import numpy as np
 
+VARIANTS = ("scalar_spectral_polarized",)
+
 
 def scene(width: int = 384, height: int = 128, spp: int = 16, max_thickness_um: float = 120.0,
           crossed: bool = True, filter_bandwidth: float = 4.0) -> dict:

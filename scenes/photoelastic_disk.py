@@ -34,6 +34,8 @@ polycarbonate photoelastic sheet), 500 N: N = 8 P C / (pi D lambda) = 3.70 at th
 
 from __future__ import annotations
 
+import pathlib
+
 import numpy as np
 
 from _common import backlight, data_texture, layer, ortho_sensor
@@ -42,6 +44,8 @@ VARIANTS = ("scalar_spectral_polarized",)
 
 #: Half-width of the camera's view in scene units; the disk has radius 1.
 VIEW_HALF = 1.05
+#: Where `write_data` puts the textures that scenes/photoelastic_disk.xml reads.
+DATA = pathlib.Path(__file__).resolve().parent / "data"
 
 
 def stress_field(x, y, load_n: float, diameter_m: float, thickness_m: float):
@@ -76,6 +80,29 @@ def principal_maps(n: int, load_n: float, diameter_mm: float, thickness_mm: floa
     return diff, angle
 
 
+def textures(load_n: float = 500.0, diameter_mm: float = 50.0, thickness_mm: float = 6.0,
+             stress_optic_per_pa: float = 8e-11, texture_size: int = 1024,
+             max_fringe_order: float = 60.0):
+    """(sigma_1 - sigma_2 in MPa, angle of sigma_1 in degrees) maps of the disk; the difference
+    is clipped where the fringe order at 550 nm would exceed `max_fringe_order` (next to the
+    loads, where it diverges)."""
+    max_mpa = max_fringe_order * 550e-9 / (stress_optic_per_pa * thickness_mm * 1e-3) / 1e6
+    return principal_maps(texture_size, load_n, diameter_mm, thickness_mm, max_mpa)
+
+
+def write_data(directory: pathlib.Path = DATA) -> list[pathlib.Path]:
+    """Writes the default textures as float EXRs for the XML version of the scene."""
+    import mitsuba as mi
+
+    directory.mkdir(parents=True, exist_ok=True)
+    paths = []
+    for suffix, values in zip(("dsigma", "angle"), textures()):
+        path = directory / f"photoelastic_disk_{suffix}.exr"
+        mi.Bitmap(np.ascontiguousarray(values, dtype=np.float32)).write(str(path))
+        paths.append(path)
+    return paths
+
+
 def scene(width: int = 512, height: int = 512, spp: int = 16, filter_bandwidth: float = 4.0,
           load_n: float = 500.0, diameter_mm: float = 50.0, thickness_mm: float = 6.0,
           stress_optic_per_pa: float = 8e-11, index: float = 1.585,
@@ -87,8 +114,8 @@ def scene(width: int = 512, height: int = 512, spp: int = 16, filter_bandwidth: 
     `max_fringe_order` (at 550 nm) clips the stress next to the loads; `crop` = (offset_x,
     offset_y, width, height) renders only that window of the width x height image.
     """
-    max_mpa = max_fringe_order * 550e-9 / (stress_optic_per_pa * thickness_mm * 1e-3) / 1e6
-    diff, angle = principal_maps(texture_size, load_n, diameter_mm, thickness_mm, max_mpa)
+    diff, angle = textures(load_n, diameter_mm, thickness_mm, stress_optic_per_pa, texture_size,
+                           max_fringe_order)
     half = VIEW_HALF
     return {
         "type": "scene",

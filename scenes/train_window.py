@@ -35,6 +35,7 @@ Variant: scalar_spectral_polarized.
 from __future__ import annotations
 
 import math
+import pathlib
 
 import numpy as np
 
@@ -43,6 +44,8 @@ from _common import T, data_texture, layer, ortho_sensor
 VARIANTS = ("scalar_spectral_polarized",)
 
 VIEW_X, VIEW_Y = 1.5, 1.0
+#: Where `write_data` puts the textures that scenes/train_window.xml reads.
+DATA = pathlib.Path(__file__).resolve().parent / "data"
 
 
 def quench_maps(n_x: int, n_y: int, pitch: float, peak_mpa: float):
@@ -59,6 +62,19 @@ def quench_maps(n_x: int, n_y: int, pitch: float, peak_mpa: float):
     diff = np.sqrt((sxx - syy) ** 2 + 4 * txy**2)
     angle = 0.5 * np.degrees(np.arctan2(2 * txy, sxx - syy))
     return diff * (peak_mpa / 2.0), angle
+
+
+def write_data(directory: pathlib.Path = DATA) -> list[pathlib.Path]:
+    """Writes the default stress textures as float EXRs for the XML version of the scene."""
+    import mitsuba as mi
+
+    directory.mkdir(parents=True, exist_ok=True)
+    paths = []
+    for suffix, values in zip(("dsigma", "angle"), quench_maps(384, 256, 0.5, 45.0)):
+        path = directory / f"train_window_{suffix}.exr"
+        mi.Bitmap(np.ascontiguousarray(values, dtype=np.float32)).write(str(path))
+        paths.append(path)
+    return paths
 
 
 def scene(width: int = 360, height: int = 240, spp: int = 32, filter_bandwidth: float = 4.0,

@@ -92,3 +92,8 @@ def scene(width: int = 384, height: int = 128, spp: int = 16, filter_bandwidth: 
         "qwp": layer(0.0, 0.45, 0.45, plate(0.25, 0.0)),
         "hwp": layer(0.0, 0.45, 0.45, plate(0.5, hwp_axis_deg), centre_x=1.0),
     }
+
+
+#: Gallery options (scenes/gallery.py): each column is uniform, so few samples suffice, and the
+#: band-filtered thin plate is the costliest query of the plugin (~0.5 ms per sample here).
+GALLERY = {"spp": 4}
