@@ -1,5 +1,6 @@
 """Waveplates: zero-order quartz quarter- and half-wave plates after a linear polariser, read with
-the `stokes` integrator.
+the `stokes` integrator (the gallery shows the Stokes vector as the colour 0.5 + 0.5 (S1, S2, S3)
+/ S0: linear at +45 degrees green, right-circular blue, linear at -15 degrees pink).
 
 What it shows: three columns of light polarised linearly at +45 degrees (counter-clockwise from
 the image's x axis, seen from the camera) by a polariser: left, nothing else (the reference);
