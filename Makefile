@@ -13,7 +13,8 @@
 #   make plugin   (part of setup) the plugin library plugin/mitsuba_birefringent/*.so and the .pth
 #   make fmt      cargo fmt --check
 #   make lint     cargo clippy on all targets, warnings are errors
-#   make clean    removes build outputs (target/, out/, Python caches); keeps .venv/
+#   make clean    removes build outputs (target/, out/, Python caches, the scenes' generated
+#                 textures scenes/data/*.exr); keeps .venv/
 #   make distclean  clean, and removes .venv/ too
 #   make bench    make setup, then the core benchmark on one core (taskset -c 0) and its plot:
 #                 bench/out/core.json, bench/out/core_error_vs_time.png (several minutes)
@@ -176,6 +177,7 @@ clean:
 	$(CARGO) clean
 	rm -f $(PLUGIN_SO)
 	rm -rf $(OUT) $(BENCH_OUT) .pytest_cache
+	rm -f scenes/data/*.exr
 	find . -path ./$(VENV) -prune -o -type d -name __pycache__ -prune -exec rm -rf {} +
 
 distclean: clean

@@ -5,9 +5,10 @@ loads along its vertical diameter, in white light (the coloured fringe orders of
 model) or, with `wavelength_nm`, monochromatic (dark fringes on a bright field).
 
 The physics: the disk (diameter D, thickness t, load P, plane stress) has the classic closed-form
-stress field of Hertz and Michell as given by M. M. Frocht, "Photoelasticity" vol. 2 (Wiley,
-1948), ch. 4, and S. Timoshenko and J. N. Goodier, "Theory of Elasticity" (3rd ed., 1970),
-sect. 41: with the loads at (0, +-R), r1^2 = x^2 + (R - y)^2, r2^2 = x^2 + (R + y)^2,
+stress field of Hertz and Michell, the standard calibration specimen of photoelasticity (M. M.
+Frocht, "Photoelasticity", Wiley; S. Timoshenko and J. N. Goodier, "Theory of Elasticity", 3rd
+ed. 1970, the chapter on two-dimensional problems in polar coordinates): with the loads at
+(0, +-R), r1^2 = x^2 + (R - y)^2, r2^2 = x^2 + (R + y)^2,
 
     sigma_x = -(2P / pi t) [ (R - y) x^2 / r1^4 + (R + y) x^2 / r2^4 - 1 / D ]
     sigma_y = -(2P / pi t) [ (R - y)^3 / r1^4 + (R + y)^3 / r2^4 - 1 / D ]
@@ -19,9 +20,9 @@ stress sigma_1 and whose birefringence is n_e - n_o = C (sigma_1 - sigma_2); `th
 takes sigma_1 - sigma_2 (MPa) as its `birefringence` texture with `birefringence_scale` = C
 (per MPa) and the principal direction as its `axis_angle` texture. A circular polariscope
 (linear polariser at 0 deg, quarter-wave retarder at 45 deg, the disk, quarter-wave retarder at
--45 deg, analyser at 90 deg; Mitsuba's ideal achromatic `retarder`) transmits
-sin^2(pi N) of the light independently of the principal directions, N = C t (sigma_1 -
-sigma_2) / lambda the fringe order: dark fringes where N is an integer.
+-45 deg, analyser at 90 deg; Mitsuba's ideal achromatic `retarder`) transmits (1/2) sin^2(pi N)
+of unpolarised light independently of the principal directions, N = C t (sigma_1 - sigma_2) /
+lambda the fringe order: dark fringes where N is an integer.
 
 The check (tests/python/test_scene_photoelastic_disk.py): in a monochromatic render the dark
 fringes measured along the horizontal and vertical diameters lie where the closed-form N along

@@ -2,12 +2,14 @@
 in a monochromatic render (550 nm, exact plate: filter_bandwidth 0) lie where the stress-optic
 law puts them.
 
-Independent reference: the fringe order along the two diameters in closed form (Frocht vol. 2
-ch. 4; Timoshenko & Goodier sect. 41), written here in 1-D form, not with the scene's 2-D field:
-on the horizontal diameter sigma_x - sigma_y = (8 P / pi D t) (1 - xi^2)^2... precisely
-sigma_1 - sigma_2 = (8 P / pi D t) (1 - xi^2) / (1 + xi^2)^2 (xi = 2 x / D, tau = 0), and on the
-vertical one (8 P / pi D t) / (1 - eta^2) (eta = 2 y / D), so N = N0 (1 - xi^2) / (1 + xi^2)^2
-resp. N0 / (1 - eta^2) with N0 = 8 P C / (pi D lambda) (the thickness cancels).
+Independent reference: the textbook stresses along the two diameters (tau_xy = 0 on both), not
+the scene's 2-D field: on the horizontal one sigma_x = (2P / pi D t) ((D^2 - 4x^2) / (D^2 +
+4x^2))^2 and sigma_y = -(2P / pi D t) (4 D^4 / (D^2 + 4x^2)^2 - 1), so sigma_1 - sigma_2 =
+(8P / pi D t) (1 - xi^2) / (1 + xi^2)^2 with xi = 2x / D; on the vertical one sigma_x =
+2P / (pi D t) and sigma_y = -(2P / pi t) (2 / (D - 2y) + 2 / (D + 2y) - 1 / D), so sigma_1 -
+sigma_2 = (8P / pi D t) / (1 - eta^2) with eta = 2y / D (at the centre 2P / (pi D t) and
+-6P / (pi D t)). Hence N = N0 (1 - xi^2) / (1 + xi^2)^2 resp. N0 / (1 - eta^2), with
+N0 = 8 P C / (pi D lambda) (the thickness cancels).
 
 Reduced run: only the pixels the check measures are rendered, as crop windows of the 512 x 512
 film (4 rows across the horizontal diameter, 4 columns across the vertical one): the same pixel
