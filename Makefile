@@ -1,9 +1,11 @@
 # mitsuba-birefringent — build, render and test entry points.
 #
 #   make render   the main job: builds everything (make setup), then renders the default scene
-#                 (a quartz wedge between crossed polarisers: the Michel-Levy interference
-#                 colours) to out/michel_levy.exr and .png, and Figure 1 of the paper's
-#                 supplemental to out/fig1.png and out/fig1.json
+#                 (a photoelastic disk under diametral compression between crossed circular
+#                 polarisers: its isochromatic fringes) to out/photoelastic_disk.exr and .png,
+#                 and Figure 1 of the paper's supplemental to out/fig1.png and out/fig1.json
+#   make gallery  make setup, then renders every scene of scenes/ at gallery size into
+#                 out/gallery/ and the contact sheet scenes/gallery.png (several minutes)
 #   make test     builds everything (make setup), then runs every test: cargo's, then pytest's
 #   make setup    cargo build --release, the virtualenv .venv/ from requirements.txt, the
 #                 Mitsuba plugin library (cpp/) and the mitsuba_birefringent package in .venv/;
@@ -11,7 +13,8 @@
 #   make plugin   (part of setup) the plugin library plugin/mitsuba_birefringent/*.so and the .pth
 #   make fmt      cargo fmt --check
 #   make lint     cargo clippy on all targets, warnings are errors
-#   make clean    removes build outputs (target/, out/, Python caches); keeps .venv/
+#   make clean    removes build outputs (target/, out/, Python caches, the scenes' generated
+#                 textures scenes/data/*.exr); keeps .venv/
 #   make distclean  clean, and removes .venv/ too
 #   make bench    make setup, then the core benchmark on one core (taskset -c 0) and its plot:
 #                 bench/out/core.json, bench/out/core_error_vs_time.png (several minutes), then
@@ -62,7 +65,7 @@ MI_LDFLAGS = -shared -L$(SITE)/mitsuba -lmitsuba -L$(SITE)/drjit -ldrjit-core \
   -Wl,--exclude-libs,ALL -Wl,--gc-sections -Wl,--strip-debug -Wl,--no-undefined \
   -lpthread -ldl -lm
 
-.PHONY: help setup build venv plugin render test test-rust test-python bench bench-scenes fmt lint clean distclean
+.PHONY: help setup build venv plugin render gallery test test-rust test-python bench bench-scenes fmt lint clean distclean
 
 help:
 	@sed -n '3,/^$$/s/^# \{0,1\}//p' $(firstword $(MAKEFILE_LIST))
@@ -112,14 +115,23 @@ $(RUST_LIB):
 
 ## ---- main job ---------------------------------------------------------------------------
 
-# The default scene (scenes/michel_levy.py, scalar_spectral_polarized, about a minute on 2 cores)
-# and Figure 1 of the supplemental (Fresnel power ratios of an isotropic/uniaxial interface,
-# computed by the calculator binary, a few seconds). Always regenerated.
+# The default scene (scenes/photoelastic_disk.py, scalar_spectral_polarized) and Figure 1 of the
+# supplemental (Fresnel power ratios of an isotropic/uniaxial interface, computed by the
+# calculator binary, a few seconds). Always regenerated.
+RENDER_SCENE ?= photoelastic_disk
 RENDER_SPP ?= 16
+RENDER_SIZE ?= 320
 render: setup
 	@mkdir -p $(OUT)
-	$(VPY) scenes/render.py michel_levy --out $(OUT) --spp $(RENDER_SPP) --width 256 --height 96
+	$(VPY) scenes/render.py $(RENDER_SCENE) --out $(OUT) --spp $(RENDER_SPP) --width $(RENDER_SIZE) --height $(RENDER_SIZE)
 	$(VPY) tools/plot_fig1.py $(BIN) $(OUT)
+
+# Every scene module of scenes/ (a `scene` function and `VARIANTS`) at gallery size, then the
+# contact sheet scenes/gallery.png (committed: the README shows it).
+GALLERY_WIDTH ?= 320
+GALLERY_SPP ?= 16
+gallery: setup
+	$(VPY) scenes/gallery.py --out $(OUT)/gallery --sheet scenes/gallery.png --width $(GALLERY_WIDTH) --spp $(GALLERY_SPP)
 
 ## ---- tests ------------------------------------------------------------------------------
 
@@ -183,6 +195,7 @@ clean:
 	$(CARGO) clean
 	rm -f $(PLUGIN_SO)
 	rm -rf $(OUT) $(BENCH_OUT) .pytest_cache
+	rm -f scenes/data/*.exr
 	find . -path ./$(VENV) -prune -o -type d -name __pycache__ -prune -exec rm -rf {} +
 
 distclean: clean

@@ -1,53 +1,115 @@
 """Render a scene of this directory to EXR and PNG.
 
-    .venv/bin/python scenes/render.py michel_levy --out out [--spp 16] [--width 384]
+    .venv/bin/python scenes/render.py photoelastic_disk --out out [--spp 16] [--width 512]
+        [--height 512] [--variant scalar_spectral_polarized] [--set load_n=800 --set ...]
 
-Each scene module has a `scene(**options)` returning a dict for `mi.load_dict` and a module
-docstring saying what it shows and in which variant.
+A scene module (`scenes/<name>.py`) has a docstring (what it shows, the physics, the check), a
+constant `VARIANTS` (the Mitsuba variants it renders in, the first is the default) and
+`scene(width=..., height=..., spp=..., filter_bandwidth=4.0, **physics_options) -> dict` for
+`mi.load_dict` (the variant is set before it is called). `--set key=value` passes a physics
+option (the value is read as a Python literal when it is one, else as a string).
+
+Outputs: `<out>/<name>.exr` (every channel of the film, named as Mitsuba names them) and
+`<out>/<name>.png` (`preview`: sRGB of the RGB channels; for a `stokes` render, the Stokes
+vector as colours; for a one-channel monochromatic film, grey).
 """
 
 from __future__ import annotations
 
 import argparse
+import ast
 import importlib
 import pathlib
 import sys
 import time
 
 import mitsuba as mi
+import numpy as np
 
-VARIANT = "scalar_spectral_polarized"
+HERE = pathlib.Path(__file__).resolve().parent
+if str(HERE) not in sys.path:
+    sys.path.insert(0, str(HERE))
 
 
-def render(name: str, out: pathlib.Path, **options) -> pathlib.Path:
-    mi.set_variant(VARIANT)
+def scene_names() -> list[str]:
+    """The scene modules of this directory: every module with `scene` and `VARIANTS`."""
+    names = []
+    for path in sorted(HERE.glob("*.py")):
+        if path.stem.startswith("_") or path.stem in ("render", "gallery"):
+            continue
+        module = importlib.import_module(path.stem)
+        if callable(getattr(module, "scene", None)) and hasattr(module, "VARIANTS"):
+            names.append(path.stem)
+    return names
+
+
+def preview(image: np.ndarray) -> np.ndarray:
+    """A displayable linear RGB image (H, W, 3) of a render: the RGB channels of an RGB film;
+    grey for a one-channel film; for the 15 channels of the `stokes` integrator (RGB, then S0..S3
+    as RGB) the normalised Stokes vector as a colour, (0.5 + 0.5 S1/S0, 0.5 + 0.5 S2/S0,
+    0.5 + 0.5 S3/S0) (linear polarisation along x: red-ish, at +45 degrees: green-ish,
+    right-circular: blue-ish; unpolarised: grey), scaled by S0 / max S0."""
+    image = np.asarray(image, dtype=np.float64)
+    if image.ndim == 2:
+        image = image[..., None]
+    channels = image.shape[-1]
+    if channels == 1:
+        return np.repeat(image, 3, axis=-1)
+    if channels == 15:
+        s = [image[..., 3 + 3 * i: 6 + 3 * i].sum(axis=-1) for i in range(4)]
+        s0 = np.where(np.abs(s[0]) > 1e-12, s[0], 1e-12)
+        colour = np.stack([0.5 + 0.5 * s[i] / s0 for i in (1, 2, 3)], axis=-1)
+        level = np.clip(s[0] / max(float(s[0].max()), 1e-12), 0.0, 1.0)[..., None]
+        return np.clip(colour, 0.0, 1.0) * level
+    return image[..., :3]
+
+
+def render(name: str, out: pathlib.Path, variant: str | None = None, seed: int = 0,
+           **options) -> pathlib.Path:
+    """Renders scene `name` with `options` to `<out>/<name>.exr` and `.png`; returns the PNG."""
+    module = importlib.import_module(name)
+    mi.set_variant(variant or module.VARIANTS[0])
     import mitsuba_birefringent  # noqa: F401  (registers the plugins for the variant set)
 
-    sys.path.insert(0, str(pathlib.Path(__file__).parent))
-    module = importlib.import_module(name)
     scene = mi.load_dict(module.scene(**options))
     start = time.perf_counter()
-    image = mi.render(scene)
+    image = mi.render(scene, seed=seed)
     seconds = time.perf_counter() - start
     out.mkdir(parents=True, exist_ok=True)
     exr = out / f"{name}.exr"
-    mi.Bitmap(image).write(str(exr))
+    scene.sensors()[0].film().bitmap().write(str(exr))
     png = out / f"{name}.png"
-    mi.util.convert_to_bitmap(image).write(str(png))
-    print(f"{name}: {exr} and {png} in {seconds:.1f} s")
+    rgb = preview(np.array(image))
+    mi.util.convert_to_bitmap(mi.Bitmap(rgb.astype(np.float32))).write(str(png))
+    print(f"{name} ({mi.variant()}): {exr} and {png} in {seconds:.1f} s")
     return png
+
+
+def parse_value(text: str):
+    try:
+        return ast.literal_eval(text)
+    except (ValueError, SyntaxError):
+        return text
 
 
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("scene")
+    p.add_argument("scene", help="one of: " + ", ".join(scene_names()))
     p.add_argument("--out", type=pathlib.Path, default=pathlib.Path("out"))
     p.add_argument("--spp", type=int, default=None)
     p.add_argument("--width", type=int, default=None)
     p.add_argument("--height", type=int, default=None)
+    p.add_argument("--variant", default=None, help="default: the scene's VARIANTS[0]")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                   help="a physics option of the scene (repeatable)")
     a = p.parse_args()
     options = {k: v for k, v in (("spp", a.spp), ("width", a.width), ("height", a.height)) if v is not None}
-    render(a.scene, a.out, **options)
+    for item in a.set:
+        key, sep, value = item.partition("=")
+        if not sep:
+            p.error(f"--set {item!r}: expected KEY=VALUE")
+        options[key] = parse_value(value)
+    render(a.scene, a.out, variant=a.variant, **options)
 
 
 if __name__ == "__main__":

@@ -1,8 +1,8 @@
-"""The default scene of `make render` (scenes/michel_levy.py): a quartz wedge between
-polarisers. At zero thickness (left edge) crossed polarisers extinguish the light and parallel
-ones pass it; where the retardation is half a wave for green light the crossed image is at its
-brightest for green; crossed + parallel = the plate's unpolarised transmission between
-polarisers, i.e. the light through one polariser (the wedge is lossless up to reflections)."""
+"""scenes/michel_levy.py (in the gallery): a quartz wedge between polarisers. At zero
+thickness (left edge) crossed polarisers extinguish the light and parallel ones pass it; where
+the retardation is half a wave for green light the crossed image is at its brightest for green;
+crossed + parallel = the plate's unpolarised transmission between polarisers, i.e. the light
+through one polariser (the wedge is lossless up to reflections)."""
 
 import pathlib
 import sys
