@@ -13,10 +13,14 @@ optic axis).
 Geometry: the film is a 2 x 2 rectangle at z = 0 seen by a perspective camera 40 degrees from
 its normal; a large rectangular D65 area light sits at the camera's mirror position, so that
 every pixel sees the film's specular reflection of the light (radiance `light_scale` times D65,
-3 by default so that the film's reflectance (about 5 to 30 %) gives mid-grey pixels). Transmitted light leaves through
-the substrate into empty space (a black background), so the image is the film's reflectance
-times the light: `thinbirefringent` with the whole plate (both interfaces and every internal
-reflection).
+3 by default so that the film's reflectance (about 5 to 30 %) gives mid-grey pixels). The
+substrate is black glass (`black_substrate`, default): silica's index at the film's bottom
+interface, and whatever enters the substrate is absorbed (`absorbing_exit`), so the image is
+the film's reflectance times the light, with no sampling noise from choosing between the
+reflected and the transmitted lobe; `thinbirefringent` computes the whole plate (both
+interfaces and every internal reflection). With `black_substrate=False` the transmitted light
+leaves through the substrate into empty space (a black background): the same mean image, but
+each sample picks reflection or transmission at random.
 
 Variants: scalar_rgb (the plate integrated in closed form over the sRGB channels: noise-free
 colour), scalar_spectral (4 sampled wavelengths per path, each through a Gaussian band of
@@ -52,7 +56,8 @@ def thickness_profile(n: int = 256) -> np.ndarray:
 
 def scene(width: int = 256, height: int = 256, spp: int = 16, filter_bandwidth: float = 4.0,
           max_thickness_um: float = MAX_THICKNESS_UM, optic_axis=(1.0, 0.0, 0.0),
-          camera_angle_deg: float = 40.0, light_scale: float = 3.0) -> dict:
+          camera_angle_deg: float = 40.0, light_scale: float = 3.0,
+          black_substrate: bool = True) -> dict:
     """The scene as a dict for `mi.load_dict` (call `mi.set_variant` first)."""
     T = mi.ScalarTransform4f
     a = np.radians(camera_angle_deg)
@@ -87,6 +92,7 @@ def scene(width: int = 256, height: int = 256, spp: int = 16, filter_bandwidth: 
                               "raw": True, "filter_type": "bilinear", "wrap_mode": "clamp"},
                 "thickness_scale": max_thickness_um,
                 "filter_bandwidth": filter_bandwidth,
+                "absorbing_exit": black_substrate,
             },
         },
     }

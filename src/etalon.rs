@@ -133,6 +133,12 @@ impl Etalon {
         None
     }
 
+    /// True if orders one round trip apart keep no coherence over `g` (`g(1) < e^{-40}`): the
+    /// band average is then the incoherent sum, the same for every such band.
+    pub fn is_incoherent(&self, g: &Gaussian) -> bool {
+        2.0 * (g.sigma * self.thickness_nm * self.w).powi(2) > 40.0
+    }
+
     /// `exp(2 i k d w)`.
     fn round_trip(&self, k: f64) -> C64 {
         C64::from_polar(1.0, 2.0 * k * self.thickness_nm * self.w)

@@ -2,8 +2,10 @@
  *
  * Components: 0 specular reflection (DeltaReflection), 1 straight-through transmission (Null when
  * exit_ior == ext_ior, else DeltaTransmission in the direction the core returns). Both carry the
- * plate's full Mueller matrix, multiple internal reflections included. Parameters: see
- * plugin/README.md. The physics is the core's bfr_plate_lobes / bfr_plate_lobes_rgb.
+ * plate's full Mueller matrix, multiple internal reflections included. With absorbing_exit the
+ * medium below absorbs whatever enters it (a film on a black substrate): only component 0 on the
+ * front side remains. Parameters: see plugin/README.md. The physics is the core's
+ * bfr_plate_lobes / bfr_plate_lobes_rgb.
  */
 #include "common.h"
 
@@ -34,6 +36,7 @@ public:
         if (props.has_property("axis_angle"))
             m_axis_angle = props.get_unbounded_texture<Texture>("axis_angle", 0.f);
         m_filter_bandwidth = props.get<double>("filter_bandwidth", DefaultFilterBandwidth);
+        m_absorbing_exit = props.get<bool>("absorbing_exit", false);
         parameters_changed();
     }
 
@@ -61,15 +64,20 @@ public:
     /// (textures at their mean), so that invalid input fails here, with the core's message.
     void parameters_changed(const std::vector<std::string> & /*keys*/ = {}) override {
         m_material = bfr::make_material(m_params, ClassName);
-        m_null = m_exit_ior == m_ext_ior;
+        m_null = m_exit_ior == m_ext_ior && !m_absorbing_exit;
         uint32_t aniso = (m_params.isotropic() && !m_birefringence) ? 0u : (uint32_t) BSDFFlags::Anisotropic;
         uint32_t sides = (uint32_t) (BSDFFlags::FrontSide | BSDFFlags::BackSide) | aniso;
         m_types[0] = BSDFFlags::DeltaReflection;
         m_types[1] = m_null ? BSDFFlags::Null : BSDFFlags::DeltaTransmission;
         m_components.clear();
-        m_components.push_back((uint32_t) m_types[0] | sides);
-        m_components.push_back((uint32_t) m_types[1] | sides);
-        m_flags = m_components[0] | m_components[1];
+        if (m_absorbing_exit) {
+            m_components.push_back((uint32_t) m_types[0] | (uint32_t) BSDFFlags::FrontSide | aniso);
+            m_flags = m_components[0];
+        } else {
+            m_components.push_back((uint32_t) m_types[0] | sides);
+            m_components.push_back((uint32_t) m_types[1] | sides);
+            m_flags = m_components[0] | m_components[1];
+        }
 
         bfr_geometry g = geometry(m_thickness->mean(), m_birefringence ? m_birefringence->mean() : 0.0,
                                   m_axis_angle ? m_axis_angle->mean() : 0.0);
@@ -88,7 +96,10 @@ public:
                                              Mask active) const override {
         MI_MASKED_FUNCTION(ProfilerPhase::BSDFSample, active);
         int32_t want = (ctx.is_enabled(m_types[0], 0) ? BFR_WANT_REFLECTION : 0) |
-                       (ctx.is_enabled(m_types[1], 1) ? BFR_WANT_TRANSMISSION : 0);
+                       (ctx.is_enabled(m_types[1], 1) && !m_absorbing_exit ? BFR_WANT_TRANSMISSION : 0);
+        // An absorbing exit medium: light never arrives from below.
+        if (m_absorbing_exit && !(Frame3f::cos_theta(si.wi) > 0.f))
+            want = 0;
         bfr_path_lobe lobes[Lobes::Channels * 2];
         if (!active || !want || !query(si, ctx.mode, want, lobes))
             return { dr::zeros<BSDFSample3f>(), dr::zeros<Spectrum>() };
@@ -131,7 +142,8 @@ public:
                 << "  birefringence_scale = " << m_birefringence_scale << "," << std::endl;
         if (m_axis_angle)
             oss << "  axis_angle = " << string::indent(m_axis_angle) << " (degrees)," << std::endl;
-        oss << "  filter_bandwidth = " << m_filter_bandwidth << " (nm FWHM, spectral variants)" << std::endl
+        oss << "  filter_bandwidth = " << m_filter_bandwidth << " (nm FWHM, spectral variants)," << std::endl
+            << "  absorbing_exit = " << (m_absorbing_exit ? "true" : "false") << std::endl
             << "]";
         return oss.str();
     }
@@ -192,7 +204,7 @@ private:
     ScalarVector3f m_optic_axis;
     ref<Texture> m_thickness, m_birefringence, m_axis_angle;
     double m_thickness_scale, m_birefringence_scale, m_filter_bandwidth;
-    bool m_null = true;
+    bool m_null = true, m_absorbing_exit = false;
     BSDFFlags m_types[2];
     mutable std::atomic<bool> m_warned { false };
 

@@ -19,6 +19,7 @@
 
 use crate::cmath;
 use crate::error::{Error, Result};
+use crate::etalon::Etalon;
 use crate::frame::PlaneFrame;
 use crate::mueller;
 use crate::paths::{PathClass, PathExpansion};
@@ -204,7 +205,7 @@ pub fn integrate_with(
     })
 }
 
-/// The isotropic fast path over a band ([`crate::etalon::Etalon::band`], exact for Gaussians), where it
+/// The isotropic fast path over a band ([`Etalon::band`], exact for Gaussians), where it
 /// applies to every Gaussian of the band.
 fn etalon_band(
     plate: &Plate,
@@ -214,9 +215,25 @@ fn etalon_band(
     output: Output,
 ) -> Option<SlabMueller> {
     let etalon = plate.etalon(std::f64::consts::TAU / band[0].mu, beta)?;
+    etalon_sum(&etalon, band, want, output, &mut None)
+}
+
+/// `Σ_j a_j` × the etalon over Gaussian `j`. Thick plates give every Gaussian the same
+/// incoherent sum: it is evaluated once (and kept in `incoherent` for further bands).
+fn etalon_sum(
+    etalon: &Etalon,
+    band: &[Gaussian],
+    want: Want,
+    output: Output,
+    incoherent: &mut Option<SlabMueller>,
+) -> Option<SlabMueller> {
     let (mut r, mut t) = (Matrix4::zeros(), Matrix4::zeros());
     for g in band {
-        let m = etalon.band(g, want, output)?;
+        let m = match (etalon.is_incoherent(g), *incoherent) {
+            (true, Some(m)) => m,
+            (true, None) => *incoherent.insert(etalon.band(g, want, output)?),
+            (false, _) => etalon.band(g, want, output)?,
+        };
         r += m.r.unwrap_or_default() * g.amplitude;
         t += m.t.unwrap_or_default() * g.amplitude;
     }
@@ -378,13 +395,13 @@ pub fn integrate_set(
     output: Output,
 ) -> Result<[SlabMueller; 3]> {
     let bands: [&[Gaussian]; 3] = std::array::from_fn(|c| gaussians(set, c));
-    if plate
-        .etalon(std::f64::consts::TAU / bands[1][0].mu, beta)
-        .is_some()
-    {
+    if let Some(e) = plate.etalon(std::f64::consts::TAU / bands[1][0].mu, beta) {
         // The isotropic fast path: a closed form per Gaussian, cheaper than any shared rule.
-        let one = |c: usize| integrate(plate, frame, beta, bands[c], want, output);
-        return Ok([one(0)?, one(1)?, one(2)?]);
+        let mut incoherent = None;
+        let mut one = |c: usize| etalon_sum(&e, bands[c], want, output, &mut incoherent);
+        if let (Some(a), Some(b), Some(c)) = (one(0), one(1), one(2)) {
+            return Ok([a, b, c]);
+        }
     }
     let all = bands.iter().flat_map(|b| b.iter());
     let lo = all

@@ -461,3 +461,26 @@ def test_light_sampling_through_the_plate_reduces_noise():
     # Same expectation: the difference of the means is within 5 standard errors.
     se = np.sqrt(bsdf_only.mean(axis=(1, 2)).var(ddof=1) / 8 + nee.mean(axis=(1, 2)).var(ddof=1) / 8)
     assert abs(bsdf_only.mean() - nee.mean()) < 5 * se + 1e-6
+
+
+@pytest.mark.parametrize("name", ["scalar_rgb", POLARIZED])
+def test_absorbing_exit_keeps_only_the_front_reflection(name):
+    """absorbing_exit: the reflection lobe alone (probability 1), equal to the reflection of
+    the same plate without it (the exit medium's absorption changes nothing above the plate);
+    from below no light (it cannot reach the plate through an absorbing medium)."""
+    variant(name)
+    kw = dict(material="quartz", thickness=0.7, optic_axis=[1, 1, 0], exit_ior=1.458)
+    black, clear = plate(absorbing_exit=True, **kw), plate(**kw)
+    assert mi.has_flag(black.flags(), mi.BSDFFlags.DeltaReflection)
+    assert not mi.has_flag(black.flags(), mi.BSDFFlags.DeltaTransmission)
+    assert not mi.has_flag(black.flags(), mi.BSDFFlags.BackSide)
+    for theta in (0.0, 35.0, 70.0):
+        si = surface_interaction(direction(theta, 20.0))
+        for u in (0.05, 0.5, 0.95):
+            bs, w = sample(black, context(), si, u)
+            assert int(bs.sampled_component) == 0 and float(bs.pdf) == pytest.approx(1.0)
+            r_clear = r_and_t(clear, si)[0]
+            # Same core query (reflection only vs both): equal to rounding.
+            np.testing.assert_allclose(w * float(bs.pdf), r_clear, rtol=1e-6, atol=1e-9)
+        bs, w = sample(black, context(), surface_interaction(direction(theta, 20.0, side=-1)))
+        assert not float(bs.pdf) > 0 and not np.any(w)
