@@ -152,7 +152,22 @@ impl Etalon {
         want: Want,
         output: Output,
     ) -> SlabMueller {
-        let geometric = |x: usize, y: usize| b(x, y) / (1.0 - self.rho[x].conj() * self.rho[y]);
+        // B_xy / (1 − conj(ρ_x) ρ_y) and S_y, each evaluated once (pairs ss, sp, pp).
+        let g = |x: usize, y: usize| b(x, y) / (1.0 - self.rho[x].conj() * self.rho[y]);
+        let zero = C64::new(0.0, 0.0);
+        let sp = if output == Output::Mueller {
+            g(0, 1)
+        } else {
+            zero
+        };
+        let geo = [[g(0, 0), sp], [sp, g(1, 1)]];
+        let geometric = |x: usize, y: usize| geo[x][y];
+        let sv = if want.reflection {
+            [s(0), s(1)]
+        } else {
+            [zero, zero]
+        };
+        let s = |y: usize| sv[y];
         let pairs = |c: &dyn Fn(usize, usize) -> C64| Diagonal {
             ss: c(0, 0).re,
             sp: match output {

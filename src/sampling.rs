@@ -17,9 +17,9 @@ use crate::material::Material;
 use crate::medium::{check_clear_index, Uniaxial};
 use crate::modes::ModeKind;
 use crate::slab::{SlabMueller, Want};
-use crate::spectral::integrate::{integrate, integrate_set, narrow_band, Output};
+use crate::spectral::integrate::{etalon_sum, integrate, integrate_set, narrow_band, Output};
 use crate::spectral::plate::Plate;
-use crate::spectral::weights::{Gaussian, WeightSet};
+use crate::spectral::weights::{gaussians, Gaussian, WeightSet};
 use crate::surface::{Incident, Surface};
 use nalgebra::{Matrix4, Vector3};
 use num_complex::Complex64 as C64;
@@ -276,12 +276,34 @@ impl PlateQuery {
 }
 
 /// The plate's lobes seen from `wi`, one `[reflection, transmission]` pair per spectral
-/// channel (one for [`Spectrum::Band`]).
+/// channel (one for [`Spectrum::Band`]). An isotropic plate ([`Plate::etalon`]) is solved once
+/// for both lobes (see [`isotropic_plate`]).
 pub fn plate_lobes(
     q: &PlateQuery,
     spectrum: &Spectrum,
     wi: Vector3<f64>,
     transport: Transport,
+) -> Result<Vec<[Option<PathLobe>; 2]>> {
+    lobes_of_plate(q, spectrum, wi, transport, true)
+}
+
+/// [`plate_lobes`] with each lobe solved on its own (the light's own side and direction): the
+/// reference the shared isotropic solution is tested against.
+pub fn plate_lobes_full(
+    q: &PlateQuery,
+    spectrum: &Spectrum,
+    wi: Vector3<f64>,
+    transport: Transport,
+) -> Result<Vec<[Option<PathLobe>; 2]>> {
+    lobes_of_plate(q, spectrum, wi, transport, false)
+}
+
+fn lobes_of_plate(
+    q: &PlateQuery,
+    spectrum: &Spectrum,
+    wi: Vector3<f64>,
+    transport: Transport,
+    share: bool,
 ) -> Result<Vec<[Option<PathLobe>; 2]>> {
     if !(wi.iter().all(|x| x.is_finite()) && (wi.norm() - 1.0).abs() < 1e-4) {
         return Err(Error::new("wi", "must be a unit vector"));
@@ -297,6 +319,11 @@ pub fn plate_lobes(
     let wi = wi.normalize();
     let reflected = Vector3::new(-wi.x, -wi.y, wi.z);
     let through = through_plate(q, wi);
+    let shared = if share {
+        isotropic_plate(q, spectrum, wi)?
+    } else {
+        None
+    };
     let lobes = [(0, Some(reflected)), (1, through)];
     for (component, wo) in lobes {
         let wanted = if component == 0 {
@@ -315,14 +342,17 @@ pub fn plate_lobes(
             reflection: component == 0,
             transmission: component == 1,
         };
-        let ms = physical_plate(q, spectrum, towards, want)?;
+        let ms = match &shared {
+            Some(ms) => ms.clone(),
+            None => physical_plate(q, spectrum, towards, want)?,
+        };
         let (n_in, n_out) = side_indices(q, towards, component);
         let scale = match transport {
             Transport::Radiance => (n_out / n_in).powi(2),
             Transport::Importance => 1.0,
         };
         let s = PlaneFrame::from_direction(towards).s;
-        for (c, (m, _)) in ms.iter().enumerate() {
+        for (c, m) in ms.iter().enumerate() {
             let m = if component == 0 { m.r } else { m.t };
             let Some(m) = m else { continue };
             let mueller = m * scale;
@@ -377,7 +407,7 @@ fn physical_plate(
     spectrum: &Spectrum,
     towards: Vector3<f64>,
     want: Want,
-) -> Result<Vec<(SlabMueller, C64)>> {
+) -> Result<Vec<SlabMueller>> {
     let (q, w, mirrored) = if towards.z > 0.0 {
         (*q, towards, false)
     } else {
@@ -395,12 +425,7 @@ fn physical_plate(
             wavelength_nm,
             fwhm_nm,
         } => {
-            if !(fwhm_nm.is_finite() && fwhm_nm >= 0.0) {
-                return Err(Error::new(
-                    "filter_bandwidth",
-                    format!("must be >= 0, got {fwhm_nm}"),
-                ));
-            }
+            check_bandwidth(fwhm_nm)?;
             if fwhm_nm == 0.0 {
                 vec![q
                     .plate
@@ -417,14 +442,75 @@ fn physical_plate(
     let fix = |m: Option<Matrix4<f64>>| m.map(|m| if mirrored { d * m * d } else { m });
     Ok(ms
         .into_iter()
-        .map(|m| {
-            (
-                SlabMueller {
-                    r: fix(m.r),
-                    t: fix(m.t),
-                },
-                beta,
-            )
+        .map(|m| SlabMueller {
+            r: fix(m.r),
+            t: fix(m.t),
         })
         .collect())
+}
+
+/// The isotropic fast path of [`plate_lobes`]: a plate for which [`Plate::etalon`] applies is
+/// solved once, from `wi`'s side, for both lobes. Reflection in Radiance mode (light from the
+/// mirror direction) sees the same incidence; transmission in Radiance mode (light from the far
+/// side) has the same Mueller matrix by reciprocity: the flux-normalised amplitudes of a
+/// lossless isotropic plate are equal both ways (`τ(1→3) = τ(3→1)`, checked against per-lobe
+/// solutions in `tests/isotropic_fast_path.rs`), and its Mueller matrices are diagonal-block,
+/// unchanged by the mirroring of a plate seen from below. `None` where the fast path does not
+/// apply.
+fn isotropic_plate(
+    q: &PlateQuery,
+    spectrum: &Spectrum,
+    wi: Vector3<f64>,
+) -> Result<Option<Vec<SlabMueller>>> {
+    let (q, w) = if wi.z > 0.0 {
+        (*q, wi)
+    } else {
+        (q.flipped(), Vector3::new(wi.x, wi.y, -wi.z))
+    };
+    let beta = q.plate.ext * (w.x * w.x + w.y * w.y).sqrt();
+    let Some(etalon) = q.plate.etalon(550.0, beta) else {
+        return Ok(None);
+    };
+    Ok(match *spectrum {
+        Spectrum::Band {
+            wavelength_nm,
+            fwhm_nm,
+        } => {
+            check_bandwidth(fwhm_nm)?;
+            if fwhm_nm == 0.0 {
+                Some(vec![etalon.mueller(wavelength_nm, q.want, q.output)])
+            } else {
+                let g = narrow_band(wavelength_nm, fwhm_nm);
+                etalon.band(&g, q.want, q.output).map(|m| vec![m])
+            }
+        }
+        Spectrum::Weights(set) => {
+            let mut incoherent = None;
+            let mut one = |c: usize| {
+                etalon_sum(
+                    &etalon,
+                    gaussians(set, c),
+                    q.want,
+                    q.output,
+                    &mut incoherent,
+                )
+            };
+            match (one(0), one(1), one(2)) {
+                (Some(a), Some(b), Some(c)) => Some(vec![a, b, c]),
+                _ => None,
+            }
+        }
+    })
+}
+
+/// `filter_bandwidth` must be finite and `>= 0`.
+fn check_bandwidth(fwhm_nm: f64) -> Result<()> {
+    if fwhm_nm.is_finite() && fwhm_nm >= 0.0 {
+        Ok(())
+    } else {
+        Err(Error::new(
+            "filter_bandwidth",
+            format!("must be >= 0, got {fwhm_nm}"),
+        ))
+    }
 }

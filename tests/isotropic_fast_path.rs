@@ -263,3 +263,65 @@ fn isotropic_crystal_lobes_equal_the_full_computation() {
     assert!(worst < 1e-10, "{worst:e}");
     assert!(tir > 100);
 }
+
+/// An isotropic plate solved once for both lobes (reciprocity for the transmission in Radiance
+/// mode) against each lobe solved from its own light direction: every field of every lobe, both
+/// transport modes, both sides, exact, band-filtered and sRGB spectra.
+#[test]
+fn isotropic_plate_lobes_shared_equal_per_lobe_solutions() {
+    use birefringent::sampling::{plate_lobes, plate_lobes_full, PlateQuery, Spectrum, Transport};
+    let mut rng = Rng::new(75);
+    let (mut worst, mut lobes) = (0.0f64, 0);
+    for i in 0..3_000 {
+        let n = rng.range(1.05, 2.6);
+        let q = PlateQuery::new(
+            Material::constant(re(n), re(n)).unwrap(),
+            0.0,
+            re(rng.range(1.0, 1.8)),
+            re(rng.range(1.0, 1.8)),
+            rng.unit_vector(),
+            10f64.powf(rng.range(1.0, 6.5)),
+            true,
+            true,
+            rng.chance(0.3),
+        )
+        .unwrap();
+        let spectrum = match i % 3 {
+            0 => Spectrum::Band {
+                wavelength_nm: rng.range(400.0, 700.0),
+                fwhm_nm: 0.0,
+            },
+            1 => Spectrum::Band {
+                wavelength_nm: rng.range(400.0, 700.0),
+                fwhm_nm: 4.0,
+            },
+            _ => Spectrum::Weights(WeightSet::SrgbD65),
+        };
+        let wi = rng.unit_vector();
+        if wi.z.abs() < 1e-3 {
+            continue;
+        }
+        for t in [Transport::Radiance, Transport::Importance] {
+            let fast = plate_lobes(&q, &spectrum, wi, t).unwrap();
+            let full = plate_lobes_full(&q, &spectrum, wi, t).unwrap();
+            for (a, b) in fast.iter().flatten().zip(full.iter().flatten()) {
+                match (a, b) {
+                    (Some(a), Some(b)) => {
+                        lobes += 1;
+                        let e = (a.mueller - b.mueller).abs().max()
+                            + (a.wo - b.wo).norm()
+                            + (a.in_stokes_x - b.in_stokes_x).norm()
+                            + (a.eta - b.eta).abs();
+                        worst = worst.max(e);
+                    }
+                    (None, None) => {}
+                    _ => panic!("lobe sets differ: {a:?} vs {b:?}"),
+                }
+            }
+        }
+    }
+    println!("isotropic plate, shared vs per-lobe solutions: worst {worst:e} over {lobes} lobes");
+    // The same closed forms from either side: rounding only (phases k d w up to ~4e4 rad).
+    assert!(worst < 1e-10, "{worst:e}");
+    assert!(lobes > 10_000);
+}

@@ -218,9 +218,9 @@ fn etalon_band(
     etalon_sum(&etalon, band, want, output, &mut None)
 }
 
-/// `Σ_j a_j` × the etalon over Gaussian `j`. Thick plates give every Gaussian the same
+/// `Σ_j a_j` × the etalon over Gaussian `j` (`None` if a series is too long). Thick plates give every Gaussian the same
 /// incoherent sum: it is evaluated once (and kept in `incoherent` for further bands).
-fn etalon_sum(
+pub fn etalon_sum(
     etalon: &Etalon,
     band: &[Gaussian],
     want: Want,
@@ -228,14 +228,22 @@ fn etalon_sum(
     incoherent: &mut Option<SlabMueller>,
 ) -> Option<SlabMueller> {
     let (mut r, mut t) = (Matrix4::zeros(), Matrix4::zeros());
+    let mut weight = 0.0; // of the incoherent Gaussians
     for g in band {
-        let m = match (etalon.is_incoherent(g), *incoherent) {
-            (true, Some(m)) => m,
-            (true, None) => *incoherent.insert(etalon.band(g, want, output)?),
-            (false, _) => etalon.band(g, want, output)?,
-        };
+        if etalon.is_incoherent(g) {
+            if incoherent.is_none() {
+                *incoherent = Some(etalon.band(g, want, output)?);
+            }
+            weight += g.amplitude;
+            continue;
+        }
+        let m = etalon.band(g, want, output)?;
         r += m.r.unwrap_or_default() * g.amplitude;
         t += m.t.unwrap_or_default() * g.amplitude;
+    }
+    if let Some(m) = incoherent.filter(|_| weight != 0.0) {
+        r += m.r.unwrap_or_default() * weight;
+        t += m.t.unwrap_or_default() * weight;
     }
     Some(SlabMueller {
         r: want.reflection.then_some(r),
