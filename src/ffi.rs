@@ -8,7 +8,9 @@
 use crate::error::{Error, Result};
 use crate::material::Material;
 use crate::medium::Uniaxial;
-use crate::sampling::{crystal_lobes, plate_lobes, PathLobe, PlateQuery, Spectrum, Transport};
+use crate::sampling::{
+    crystal_lobes, plate_lobes, PathLobe, PlateQuery, Spectrum, Transport, MAX_BANDS,
+};
 use crate::spectral::weights::WeightSet;
 use crate::surface::Surface;
 use crate::C64;
@@ -397,6 +399,66 @@ pub unsafe extern "C" fn bfr_plate_lobes(
             message,
             message_len,
         )
+    }
+}
+
+/// Plate lobes at up to [`MAX_BANDS`] wavelengths at once (each exact or band-filtered, as
+/// [`bfr_plate_lobes`]): `out[2 i..2 i + 2]` for `wavelengths_nm[i]`.
+///
+/// # Safety
+/// Valid pointers; `wavelengths_nm` holds `count` values and `out` `2 × count` entries;
+/// `message` null or writable.
+#[no_mangle]
+pub unsafe extern "C" fn bfr_plate_lobes_n(
+    m: *const BfrMaterial,
+    g: *const BfrGeometry,
+    wavelengths_nm: *const f64,
+    count: usize,
+    fwhm_nm: f64,
+    wi: *const f64,
+    transport_mode: i32,
+    flags: i32,
+    out: *mut BfrPathLobe,
+    message: *mut c_char,
+    message_len: usize,
+) -> i32 {
+    // SAFETY: the caller's contract; the count is checked before anything is read.
+    unsafe {
+        let mut spectrum = None;
+        let rc = guarded(message, message_len, || {
+            if wavelengths_nm.is_null() {
+                return Err(null("wavelengths_nm"));
+            }
+            if !(1..=MAX_BANDS).contains(&count) {
+                return Err(Error::new(
+                    "count",
+                    format!("must be 1 to {MAX_BANDS} wavelengths, got {count}"),
+                ));
+            }
+            let mut w = [0.0; MAX_BANDS];
+            w[..count].copy_from_slice(std::slice::from_raw_parts(wavelengths_nm, count));
+            spectrum = Some(Spectrum::Bands {
+                wavelengths_nm: w,
+                count,
+                fwhm_nm,
+            });
+            Ok(())
+        });
+        match spectrum {
+            Some(spectrum) => plate_entry(
+                m,
+                g,
+                spectrum,
+                count,
+                wi,
+                transport_mode,
+                flags,
+                out,
+                message,
+                message_len,
+            ),
+            None => rc,
+        }
     }
 }
 

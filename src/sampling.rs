@@ -221,6 +221,55 @@ pub enum Spectrum {
     },
     /// Every channel of a weight set (closed form).
     Weights(WeightSet),
+    /// The first `count` (at most [`MAX_BANDS`]) wavelengths of `wavelengths_nm`, each as
+    /// [`Spectrum::Band`] with the same `fwhm_nm`: the wavelengths a spectral renderer traces
+    /// along one path, answered in one query (a plate's wavelength-independent work is shared).
+    Bands {
+        /// Centre wavelengths (nm).
+        wavelengths_nm: [f64; MAX_BANDS],
+        /// How many of them are used.
+        count: usize,
+        /// Full width at half maximum (nm).
+        fwhm_nm: f64,
+    },
+}
+
+/// Most wavelengths of one [`Spectrum::Bands`] query (Mitsuba's spectral variants trace 4).
+pub const MAX_BANDS: usize = 4;
+
+impl Spectrum {
+    /// Channels of the answer.
+    fn channels(&self) -> Result<usize> {
+        match *self {
+            Spectrum::Band { .. } => Ok(1),
+            Spectrum::Weights(_) => Ok(3),
+            Spectrum::Bands { count, .. } if (1..=MAX_BANDS).contains(&count) => Ok(count),
+            Spectrum::Bands { count, .. } => Err(Error::new(
+                "count",
+                format!("must be 1 to {MAX_BANDS} wavelengths, got {count}"),
+            )),
+        }
+    }
+
+    /// The single bands `(wavelength_nm, fwhm_nm)` of a [`Spectrum::Band`] or
+    /// [`Spectrum::Bands`] (empty for weights).
+    fn bands(&self) -> Vec<(f64, f64)> {
+        match *self {
+            Spectrum::Band {
+                wavelength_nm,
+                fwhm_nm,
+            } => vec![(wavelength_nm, fwhm_nm)],
+            Spectrum::Bands {
+                wavelengths_nm,
+                count,
+                fwhm_nm,
+            } => wavelengths_nm[..count.min(MAX_BANDS)]
+                .iter()
+                .map(|&l| (l, fwhm_nm))
+                .collect(),
+            Spectrum::Weights(_) => Vec::new(),
+        }
+    }
 }
 
 impl PlateQuery {
@@ -308,10 +357,7 @@ fn lobes_of_plate(
     if !(wi.iter().all(|x| x.is_finite()) && (wi.norm() - 1.0).abs() < 1e-4) {
         return Err(Error::new("wi", "must be a unit vector"));
     }
-    let channels = match spectrum {
-        Spectrum::Band { .. } => 1,
-        Spectrum::Weights(_) => 3,
-    };
+    let channels = spectrum.channels()?;
     let mut out = vec![[None, None]; channels];
     if wi.z == 0.0 {
         return Ok(out);
@@ -421,22 +467,22 @@ fn physical_plate(
     let beta = q.plate.ext * (w.x * w.x + w.y * w.y).sqrt();
     let one = |band: &[Gaussian]| integrate(&q.plate, &frame, beta, band, want, q.output);
     let ms: Vec<SlabMueller> = match *spectrum {
-        Spectrum::Band {
-            wavelength_nm,
-            fwhm_nm,
-        } => {
-            check_bandwidth(fwhm_nm)?;
-            if fwhm_nm == 0.0 {
-                vec![q
-                    .plate
-                    .mueller_at(wavelength_nm, &frame, beta, want, q.output)?]
-            } else {
-                vec![one(&[narrow_band(wavelength_nm, fwhm_nm)])?]
-            }
-        }
         Spectrum::Weights(set) => {
             integrate_set(&q.plate, &frame, beta, set, want, q.output)?.to_vec()
         }
+        _ => spectrum
+            .bands()
+            .into_iter()
+            .map(|(wavelength_nm, fwhm_nm)| {
+                check_bandwidth(fwhm_nm)?;
+                if fwhm_nm == 0.0 {
+                    q.plate
+                        .mueller_at(wavelength_nm, &frame, beta, want, q.output)
+                } else {
+                    one(&[narrow_band(wavelength_nm, fwhm_nm)])
+                }
+            })
+            .collect::<Result<_>>()?,
     };
     let d = Matrix4::from_diagonal(&nalgebra::Vector4::new(1.0, 1.0, -1.0, -1.0));
     let fix = |m: Option<Matrix4<f64>>| m.map(|m| if mirrored { d * m * d } else { m });
@@ -472,17 +518,34 @@ fn isotropic_plate(
         return Ok(None);
     };
     Ok(match *spectrum {
-        Spectrum::Band {
-            wavelength_nm,
-            fwhm_nm,
-        } => {
-            check_bandwidth(fwhm_nm)?;
-            if fwhm_nm == 0.0 {
-                Some(vec![etalon.mueller(wavelength_nm, q.want, q.output)])
-            } else {
-                let g = narrow_band(wavelength_nm, fwhm_nm);
-                etalon.band(&g, q.want, q.output).map(|m| vec![m])
+        Spectrum::Band { .. } | Spectrum::Bands { .. } => {
+            // One etalon for every wavelength (constant indices); a band thicker than its
+            // coherence length gives the same incoherent sum at every wavelength.
+            let mut incoherent = None;
+            let mut ms = Vec::new();
+            for (wavelength_nm, fwhm_nm) in spectrum.bands() {
+                check_bandwidth(fwhm_nm)?;
+                let m = if fwhm_nm == 0.0 {
+                    etalon.mueller(wavelength_nm, q.want, q.output)
+                } else {
+                    let g = narrow_band(wavelength_nm, fwhm_nm);
+                    match (etalon.is_incoherent(&g), incoherent) {
+                        (true, Some(m)) => m,
+                        (true, None) => {
+                            *incoherent.insert(match etalon.band(&g, q.want, q.output) {
+                                Some(m) => m,
+                                None => return Ok(None),
+                            })
+                        }
+                        (false, _) => match etalon.band(&g, q.want, q.output) {
+                            Some(m) => m,
+                            None => return Ok(None),
+                        },
+                    }
+                };
+                ms.push(m);
             }
+            Some(ms)
         }
         Spectrum::Weights(set) => {
             let mut incoherent = None;

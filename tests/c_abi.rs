@@ -169,6 +169,34 @@ fn c_program_agrees_with_the_rust_api() {
             0.0
         ]
     );
+    // Three wavelengths in one query equal three single queries (band-filtered, 4 nm).
+    assert_eq!(lines[at + 4], "bands 0");
+    let q = PlateQuery::new(
+        calcite,
+        0.0,
+        C64::new(1.0, 0.0),
+        C64::new(1.0, 0.0),
+        axis,
+        2500.0,
+        true,
+        true,
+        false,
+    )
+    .unwrap();
+    for (i, wavelength_nm) in [450.0, 550.0, 650.0].into_iter().enumerate() {
+        let band = Spectrum::Band {
+            wavelength_nm,
+            fwhm_nm: 4.0,
+        };
+        let p = plate_lobes(&q, &band, wi, Transport::Radiance).unwrap();
+        expect_lobe(lines[at + 5 + 2 * i], p[0][0].as_ref());
+        expect_lobe(lines[at + 6 + 2 * i], p[0][1].as_ref());
+    }
+    assert_eq!(
+        lines[at + 11],
+        "too many 1 count: must be 1 to 4 wavelengths, got 5"
+    );
+    let at = at + 8;
     assert!(lines[at + 4].starts_with("bad material 1 material: unknown crystal 'unobtainium'"));
     assert!(
         lines[at + 5].starts_with("bad axis 1 optic_axis:"),

@@ -106,6 +106,17 @@ int32_t bfr_plate_lobes(const bfr_material *material, const bfr_geometry *geomet
                         int32_t transport, int32_t flags, bfr_path_lobe out[2], char *message,
                         size_t message_len);
 
+/* Most wavelengths of one bfr_plate_lobes_n query. */
+#define BFR_MAX_BANDS 4
+
+/* bfr_plate_lobes at count (1..BFR_MAX_BANDS) wavelengths at once, the same fwhm_nm for all:
+ * out[2 i], out[2 i + 1] for wavelengths_nm[i]. The plate's wavelength-independent work is done
+ * once (the wavelengths a spectral renderer traces along one path). */
+int32_t bfr_plate_lobes_n(const bfr_material *material, const bfr_geometry *geometry,
+                          const double *wavelengths_nm, size_t count, double fwhm_nm,
+                          const double *wi, int32_t transport, int32_t flags,
+                          bfr_path_lobe *out, char *message, size_t message_len);
+
 /* Plate integrated in closed form over the linear sRGB (D65) channel weights (each normalised
  * so that a spectrally flat response of 1 gives 1): out[c][0..2] for channels c = R, G, B. */
 int32_t bfr_plate_lobes_rgb(const bfr_material *material, const bfr_geometry *geometry,

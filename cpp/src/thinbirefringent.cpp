@@ -184,10 +184,13 @@ private:
                 for (size_t i = 0; i < 2; ++i)
                     lobes[ch * 2 + i] = rgb[ch][i];
         } else {
-            for (size_t ch = 0; ch < Lobes::Channels && rc == BFR_OK; ++ch)
-                rc = bfr_plate_lobes(m_material.get(), &g, (double) si.wavelengths[ch],
-                                     m_filter_bandwidth, wi, transport, flags, &lobes[ch * 2],
-                                     message, sizeof(message));
+            static_assert(Lobes::Channels <= BFR_MAX_BANDS, "one core query per path");
+            double waves[Lobes::Channels];
+            for (size_t ch = 0; ch < Lobes::Channels; ++ch)
+                waves[ch] = (double) si.wavelengths[ch];
+            rc = bfr_plate_lobes_n(m_material.get(), &g, waves, Lobes::Channels,
+                                   m_filter_bandwidth, wi, transport, flags, lobes, message,
+                                   sizeof(message));
         }
         if (rc != BFR_OK) {
             if (!m_warned.exchange(true))

@@ -41,6 +41,16 @@ int main(void) {
     printf("rgb %d %.17g %.17g %.17g %d\n", rc, rgb[0][1].weight, rgb[1][1].weight,
            rgb[2][1].weight, rgb[0][0].exists);
 
+    const double waves[3] = {450.0, 550.0, 650.0};
+    bfr_path_lobe multi[2 * BFR_MAX_BANDS];
+    rc = bfr_plate_lobes_n(calcite, &g, waves, 3, 4.0, wi, BFR_RADIANCE,
+                           BFR_WANT_REFLECTION | BFR_WANT_TRANSMISSION, multi, msg, sizeof msg);
+    printf("bands %d\n", rc);
+    for (int i = 0; i < 6; ++i) print_lobe("lobe", &multi[i]);
+    rc = bfr_plate_lobes_n(calcite, &g, waves, BFR_MAX_BANDS + 1, 4.0, wi, BFR_RADIANCE, 3,
+                           multi, msg, sizeof msg);
+    printf("too many %d %s\n", rc, msg);
+
     bfr_material_desc bad_desc = {"unobtainium", {0, 0}, {0, 0}, 0.0, 0.0};
     bfr_material *none = bfr_material_new(&bad_desc, msg, sizeof msg);
     printf("bad material %d %s\n", none == NULL, msg);
