@@ -141,20 +141,28 @@ impl SlabOptics {
 
     /// Propagation factors `(P↓, P↑)` through the layer at vacuum wavelength `lambda_nm`.
     pub fn propagation(&self, lambda_nm: f64) -> (Matrix2<C64>, Matrix2<C64>) {
-        let m = self.layer_modes();
-        let q = [m.down[0].q, m.down[1].q, m.up[0].q, m.up[1].q];
-        self.propagation_with(lambda_nm, &q)
+        propagation(self.thickness_nm, lambda_nm, &self.layer_q())
     }
 
-    /// Propagation factors for given normal components `[o↓, e↓, o↑, e↑]` of the layer's modes.
-    fn propagation_with(&self, lambda_nm: f64, q: &[C64; 4]) -> (Matrix2<C64>, Matrix2<C64>) {
-        let kd = std::f64::consts::TAU * self.thickness_nm / lambda_nm;
-        let i = C64::new(0.0, 1.0);
-        let p = |k: usize, sign: f64| (i * q[k] * (sign * kd)).exp();
-        (
-            Matrix2::from_diagonal(&nalgebra::Vector2::new(p(0, -1.0), p(1, -1.0))),
-            Matrix2::from_diagonal(&nalgebra::Vector2::new(p(2, 1.0), p(3, 1.0))),
-        )
+    /// The layer's normal components `[o↓, e↓, o↑, e↑]`.
+    pub fn layer_q(&self) -> [C64; 4] {
+        let m = self.layer_modes();
+        [m.down[0].q, m.down[1].q, m.up[0].q, m.up[1].q]
+    }
+
+    /// What [`SlabOptics::jones`] needs besides the wavelength.
+    pub fn blocks(&self) -> SlabBlocks {
+        SlabBlocks {
+            r1: self.top.r_above(),
+            t1: self.top.t_above(),
+            r3: self.top.r_below(),
+            t3: self.top.t_below(),
+            r2: self.bottom.r_above(),
+            t2: self.bottom.t_above(),
+            q: self.layer_q(),
+            flux: self.transmission_flux_ratio(),
+            thickness_nm: self.thickness_nm,
+        }
     }
 
     /// Flux ratio per unit amplitude `P_bottom / P_top` (transmission power factor, seed S19).
@@ -172,10 +180,10 @@ impl SlabOptics {
     /// Fails only at an exact internal resonance (`I − D` singular: a guided mode, which light
     /// from outside cannot excite in a passive slab).
     pub fn jones(&self, lambda_nm: f64, want: Want) -> Result<SlabJones> {
-        self.jones_with(self.propagation(lambda_nm), want)
+        self.blocks().jones(lambda_nm, want)
     }
 
-    /// [`SlabOptics::jones`] with the interfaces of `self` and the layer phases of the normal
+    /// [`SlabOptics::mueller`] with the interfaces of `self` and the layer phases of the normal
     /// components `q` (`[o↓, e↓, o↑, e↑]`, e.g. [`crate::modes::normal_components`] at a nearby
     /// wavelength): a dispersive plate across a narrow band, where the amplitudes barely change
     /// but the phases do.
@@ -185,30 +193,11 @@ impl SlabOptics {
         q: &[C64; 4],
         want: Want,
     ) -> Result<SlabMueller> {
-        let j = self.jones_with(self.propagation_with(lambda_nm, q), want)?;
-        Ok(SlabMueller {
-            r: j.r.as_ref().map(mueller::from_jones),
-            t: j.t.as_ref().map(mueller::from_jones),
-        })
-    }
-
-    fn jones_with(&self, (pd, pu): (Matrix2<C64>, Matrix2<C64>), want: Want) -> Result<SlabJones> {
-        let (t1, r1) = (self.top.t_above(), self.top.r_above());
-        let (t3, r3) = (self.top.t_below(), self.top.r_below());
-        let (t2, r2) = (self.bottom.t_above(), self.bottom.r_above());
-        let d = r3 * pu * r2 * pd;
-        let inner = (Matrix2::identity() - d).try_inverse().ok_or_else(|| {
-            Error::new(
-                "slab",
-                "internal resonance: the multiple-reflection sum diverges",
-            )
-        })? * t1;
-        let r = want.reflection.then(|| r1 + t3 * pu * r2 * pd * inner);
-        let t = want.transmission.then(|| {
-            let f = self.transmission_flux_ratio().sqrt();
-            t2 * pd * inner * C64::new(f, 0.0)
-        });
-        Ok(SlabJones { r, t })
+        SlabBlocks {
+            q: *q,
+            ..self.blocks()
+        }
+        .mueller(lambda_nm, want)
     }
 
     /// Mueller matrices (Mitsuba's convention, s/p frames) of reflection and transmission.
@@ -218,5 +207,106 @@ impl SlabOptics {
             r: j.r.as_ref().map(mueller::from_jones),
             t: j.t.as_ref().map(mueller::from_jones),
         })
+    }
+}
+
+/// Propagation factors `(P↓, P↑) = (diag exp(−i k0 q↓ d), diag exp(i k0 q↑ d))` of a layer of
+/// thickness `thickness_nm` with normal components `q = [o↓, e↓, o↑, e↑]`.
+fn propagation(thickness_nm: f64, lambda_nm: f64, q: &[C64; 4]) -> (Matrix2<C64>, Matrix2<C64>) {
+    let kd = std::f64::consts::TAU * thickness_nm / lambda_nm;
+    let i = C64::new(0.0, 1.0);
+    let p = |k: usize, sign: f64| (i * q[k] * (sign * kd)).exp();
+    (
+        Matrix2::from_diagonal(&nalgebra::Vector2::new(p(0, -1.0), p(1, -1.0))),
+        Matrix2::from_diagonal(&nalgebra::Vector2::new(p(2, 1.0), p(3, 1.0))),
+    )
+}
+
+/// The slab's amplitudes that do not depend on the wavelength at fixed indices: the interface
+/// blocks (1: top from above, 3: top from below, 2: bottom from above), the layer's normal
+/// components and the transmission flux factor. With the wavelength they give the plate
+/// (module docs); across a spectrum they can be interpolated (they vary only with the indices).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SlabBlocks {
+    /// Top interface, reflection from above.
+    pub r1: Matrix2<C64>,
+    /// Top interface, transmission from above.
+    pub t1: Matrix2<C64>,
+    /// Top interface, reflection from below.
+    pub r3: Matrix2<C64>,
+    /// Top interface, transmission from below.
+    pub t3: Matrix2<C64>,
+    /// Bottom interface, reflection from above.
+    pub r2: Matrix2<C64>,
+    /// Bottom interface, transmission from above.
+    pub t2: Matrix2<C64>,
+    /// Layer normal components `[o↓, e↓, o↑, e↑]`.
+    pub q: [C64; 4],
+    /// Transmission flux factor `P_bottom / P_top`.
+    pub flux: f64,
+    /// Thickness (nm).
+    pub thickness_nm: f64,
+}
+
+/// Number of complex values in [`SlabBlocks::values`].
+pub const BLOCK_VALUES: usize = 29;
+
+impl SlabBlocks {
+    /// The Jones matrices at `lambda_nm` ([`SlabOptics::jones`]).
+    pub fn jones(&self, lambda_nm: f64, want: Want) -> Result<SlabJones> {
+        let (pd, pu) = propagation(self.thickness_nm, lambda_nm, &self.q);
+        let d = self.r3 * pu * self.r2 * pd;
+        let inner = (Matrix2::identity() - d).try_inverse().ok_or_else(|| {
+            Error::new(
+                "slab",
+                "internal resonance: the multiple-reflection sum diverges",
+            )
+        })? * self.t1;
+        let r = want
+            .reflection
+            .then(|| self.r1 + self.t3 * pu * self.r2 * pd * inner);
+        let t = want
+            .transmission
+            .then(|| self.t2 * pd * inner * C64::new(self.flux.sqrt(), 0.0));
+        Ok(SlabJones { r, t })
+    }
+
+    /// The Mueller matrices at `lambda_nm` ([`SlabOptics::mueller`]).
+    pub fn mueller(&self, lambda_nm: f64, want: Want) -> Result<SlabMueller> {
+        let j = self.jones(lambda_nm, want)?;
+        Ok(SlabMueller {
+            r: j.r.as_ref().map(mueller::from_jones),
+            t: j.t.as_ref().map(mueller::from_jones),
+        })
+    }
+
+    /// All values as one array (blocks row by row, then `q`, then the flux).
+    pub fn values(&self) -> [C64; BLOCK_VALUES] {
+        let mut v = [C64::new(0.0, 0.0); BLOCK_VALUES];
+        let blocks = [self.r1, self.t1, self.r3, self.t3, self.r2, self.t2];
+        for (b, m) in blocks.iter().enumerate() {
+            for k in 0..4 {
+                v[4 * b + k] = m[(k / 2, k % 2)];
+            }
+        }
+        v[24..28].copy_from_slice(&self.q);
+        v[28] = C64::new(self.flux, 0.0);
+        v
+    }
+
+    /// The inverse of [`SlabBlocks::values`].
+    pub fn from_values(v: &[C64; BLOCK_VALUES], thickness_nm: f64) -> Self {
+        let m = |b: usize| Matrix2::new(v[4 * b], v[4 * b + 1], v[4 * b + 2], v[4 * b + 3]);
+        SlabBlocks {
+            r1: m(0),
+            t1: m(1),
+            r3: m(2),
+            t3: m(3),
+            r2: m(4),
+            t2: m(5),
+            q: [v[24], v[25], v[26], v[27]],
+            flux: v[28].re,
+            thickness_nm,
+        }
     }
 }

@@ -23,8 +23,9 @@ use crate::etalon::Etalon;
 use crate::frame::PlaneFrame;
 use crate::mueller;
 use crate::paths::{PathClass, PathExpansion};
-use crate::slab::{SlabMueller, SlabOptics, Want};
+use crate::slab::{SlabBlocks, SlabMueller, SlabOptics, Want};
 use crate::spectral::hermite;
+use crate::spectral::interpolate::BlockInterpolant;
 use crate::spectral::narrow;
 use crate::spectral::plate::Plate;
 use crate::spectral::weights::{gaussians, Gaussian, WeightSet};
@@ -429,20 +430,36 @@ pub fn integrate_set(
         rt = rt.max(group_round_trips(&o, &dispersion(plate, frame, beta, k)?, k).1);
     }
     let oscillations = optics.thickness_nm * rt * orders * (hi - lo) / std::f64::consts::TAU;
-    let panels = ((2.0 * oscillations).ceil() as usize).max(8);
+    // Two thirds of an oscillation of the fastest significant order per 8-point Gauss–Legendre
+    // panel: the rule integrates exp(i ω x) over that span to ~1e-12 (and over one period to
+    // 9e-11; the estimate of the fastest order can be low by a few tens of per cent).
+    let panels = ((1.5 * oscillations).ceil() as usize).max(8);
     if panels * 8 > SHARED_NODES_MAX {
         let one = |c: usize| integrate(plate, frame, beta, bands[c], want, output);
         return Ok([one(0)?, one(1)?, one(2)?]);
     }
-    let fixed = (!plate.is_dispersive()).then_some(optics);
+    // The blocks at each node: fixed without dispersion; else interpolated across the band
+    // (checked; exact at every node where the interpolant is refused).
+    let exact = |k: f64| -> Result<SlabBlocks> {
+        Ok(plate
+            .at(std::f64::consts::TAU / k)?
+            .optics(frame, beta)?
+            .blocks())
+    };
+    let fixed = (!plate.is_dispersive()).then(|| optics.blocks());
+    let interpolant = match fixed {
+        Some(_) => None,
+        None => BlockInterpolant::new(lo, hi, optics.thickness_nm, &exact)?,
+    };
     let mut acc = [(Matrix4::zeros(), Matrix4::zeros()); 3];
     for (k, w) in hermite::composite_interval(lo, hi, panels) {
         let lambda = std::f64::consts::TAU / k;
-        let o = match fixed {
-            Some(o) => o,
-            None => plate.at(lambda)?.optics(frame, beta)?,
+        let blocks = match (fixed, &interpolant) {
+            (Some(b), _) => b,
+            (None, Some(f)) => f.at(k),
+            (None, None) => exact(k)?,
         };
-        let m = o.mueller(lambda, want)?;
+        let m = blocks.mueller(lambda, want)?;
         for (c, band) in bands.iter().enumerate() {
             let wc = w * band
                 .iter()

@@ -3,6 +3,7 @@
 
 pub mod hermite;
 pub mod integrate;
+pub mod interpolate;
 pub mod narrow;
 pub mod plate;
 pub mod weights;
