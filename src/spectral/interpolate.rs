@@ -73,7 +73,7 @@ impl BlockInterpolant {
                 .zip(&got)
                 .map(|(a, b)| (a - b).norm())
                 .fold(0.0, f64::max);
-            if !(err <= TOLERANCE * largest) {
+            if err.is_nan() || err > TOLERANCE * largest {
                 return Ok(None);
             }
         }
