@@ -17,8 +17,8 @@
 #                 (the C ABI, the JSON calculator) for FUZZ_SECONDS each (default 600), then the
 #                 plugin-parameter fuzzer for FUZZ_SECONDS; FUZZ_STRICT=1 also fails on known,
 #                 reported defects (see tests/fuzz/run.sh)
-#   make fuzz-ci  (part of test) the same for FUZZ_CI_SECONDS per libFuzzer target (15) and
-#                 PLUGIN_FUZZ_CI_SECONDS (30) for the plugin fuzzer
+#   make fuzz-ci  (part of test) the same for FUZZ_CI_SECONDS per libFuzzer target (10) and
+#                 PLUGIN_FUZZ_CI_SECONDS (20) for the plugin fuzzer
 #   make bench    make setup, then the core benchmark on one core (taskset -c 0) and its plot:
 #                 bench/out/core.json, bench/out/core_error_vs_time.png (several minutes)
 
@@ -150,8 +150,8 @@ test-python: plugin
 # mi.load_dict in every supported variant, one worker subprocess at a time (a segfault is a
 # finding, its input kept in target/fuzz/plugin/). Both print executions and exit 1 on a crash.
 FUZZ_SECONDS ?= 600
-FUZZ_CI_SECONDS ?= 15
-PLUGIN_FUZZ_CI_SECONDS ?= 30
+FUZZ_CI_SECONDS ?= 10
+PLUGIN_FUZZ_CI_SECONDS ?= 20
 
 fuzz: setup
 	CARGO=$(CARGO) tests/fuzz/run.sh $(FUZZ_SECONDS)

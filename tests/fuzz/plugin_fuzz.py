@@ -120,22 +120,50 @@ def case(seed: int, index: int) -> dict:
 
 # A case whose one query is slower than this (s) is listed as slow; the budget ends a slow case
 # GRACE seconds after the deadline (listed, not a failure).
-SLOW, GRACE = 10.0, 20.0
+SLOW, GRACE = 10.0, 10.0
+
+
+def numbers(v) -> list[float]:
+    """The finite numbers of a parameter value (a float, or a texture's nested values)."""
+    if isinstance(v, bool):
+        return []
+    if isinstance(v, (int, float)):
+        return [float(v)] if math.isfinite(v) else []
+    if isinstance(v, dict):
+        return [x for w in v.values() for x in numbers(w)]
+    return []
+
+
+def extreme(d: dict) -> list[str]:
+    """Parameters of magnitude beyond 1e6 (an index, an extinction coefficient, a birefringence
+    (times its scale), or a thickness in um (times its scale)): the bound of the libFuzzer
+    targets' known_extreme (tests/fuzz/src/lib.rs)."""
+    def biggest(key, scale_key=None):
+        xs = [abs(x) for x in numbers(d.get(key))]
+        scale = abs(d.get(scale_key, 1.0)) if isinstance(d.get(scale_key, 1.0), float) else 1.0
+        return max(xs, default=0.0) * (scale if math.isfinite(scale) else 1.0)
+    out = [k for k in ("eta_o", "eta_e", "kappa_o", "kappa_e") if biggest(k) > 1e6]
+    out += [k for k, sk in (("birefringence", "birefringence_scale"), ("thickness", "thickness_scale"))
+            if biggest(k, sk) > 1e6]
+    return out
 
 
 def known_finding(d: dict, what: str) -> str | None:
     """Why a finding is a known, reported defect (listed, not failing unless --strict), or None.
 
-    Reported to the lead: indices or extinction coefficients of huge magnitude (>~1e16) break the
-    core's arithmetic (e.g. quartz with kappa_o = 6.3e70 gives a crystal reflection lobe of
-    weight 1.4e108, finite in double), and the shim converts such finite doubles to float
-    without a range check, so Mitsuba receives inf. The bound 1e6 is the one of the libFuzzer
-    targets (tests/fuzz/src/lib.rs, known_extreme). Remove once the core refuses them."""
-    if not what.startswith("FAIL sample weight not finite"):
+    Reported to the lead, both at magnitudes beyond 1e6 (the libFuzzer targets skip the same):
+    - huge extinction coefficients break the core's arithmetic (quartz with kappa_o = 6.3e70
+      gives a crystal reflection lobe of weight 1.4e108, finite in double), and the shim
+      converts such finite doubles to float without a range check, so Mitsuba receives inf;
+    - the band-filtered plate sizes its quadrature from the index and the thickness without a
+      bound: its cost grows linearly with them (calcite, kappa_e 20, birefringence 1e4: 15 s
+      per query) and at birefringence 1e7 it asks for 64 GB, an allocation failure that aborts
+      the renderer (SIGABRT, the worker's exit -6).
+    Remove once the core refuses or bounds them."""
+    if not (what.startswith("FAIL sample weight not finite") or what.startswith("CRASH worker exit -6")):
         return None
-    huge = [k for k in ("eta_o", "eta_e", "kappa_o", "kappa_e")
-            if isinstance(d.get(k), float) and math.isfinite(d[k]) and abs(d[k]) > 1e6]
-    return f"|{', '.join(huge)}| > 1e6: core breakdown + float overflow in the shim" if huge else None
+    huge = extreme(d)
+    return f"|{', '.join(huge)}| > 1e6: reported core defect (see known_finding)" if huge else None
 
 
 def keys_of(d) -> set[str]:
@@ -302,7 +330,13 @@ def run(args) -> int:
                 break
             else:
                 # The worker died by itself: a signal (crash) or an uncaught error, in case idx.
-                findings.append((variant, idx, f"CRASH worker exit {p.returncode}: {err.strip()[-600:]}"))
+                # The message (a Rust panic or allocation failure, a Python error) if there is one,
+                # else the end of the worker's standard error.
+                lines_err = err.strip().splitlines()
+                said = [x for x in lines_err
+                        if any(w in x for w in ("panicked", "memory allocation", "Error", "error"))]
+                tail = " | ".join((said or lines_err)[-3:])
+                findings.append((variant, idx, f"CRASH worker exit {p.returncode}: {tail[-600:]}"))
             start = idx + 1
         totals[variant] = counts
         print(f"plugin fuzz {variant}: {start} cases, {counts['loaded']} loaded (each queried "

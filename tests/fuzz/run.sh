@@ -15,7 +15,8 @@
 #
 # Per target: the working corpus is target/fuzz/corpus/TARGET (grows across runs, not
 # committed), seeded from tests/fuzz/corpus/TARGET (committed); crashing, timing-out or
-# memory-hungry inputs are written to target/fuzz/artifacts/TARGET/ and the script exits 1.
+# memory-hungry inputs are written to target/fuzz/artifacts/TARGET/ and the script exits 1
+# (slow inputs are kept there too, as timeout-*, and listed; see the libFuzzer options below).
 # Inputs that break only the soft contract (the core's *internal* error, BFR_INTERNAL or "a bug:
 # please report the input": a clean error status, no non-finite number handed out, but a core
 # defect; or a finite power fraction above 1) are kept in target/fuzz/findings/TARGET/ and
@@ -64,15 +65,25 @@ for t in "${targets[@]}"; do
   findings="$out/findings/$t"
   mkdir -p "$findings"
   rc=0
-  # -timeout: one input running longer than FUZZ_TIMEOUT (default 60 s) is a finding (a hang;
-  # single sRGB-integrated plate queries near grazing incidence are known to take 5-50 s);
-  # -rss_limit_mb: a memory blow-up is one too. -max_len: documents and arguments are short.
-  FUZZ_FINDINGS="$findings" "$bin" -max_total_time="$secs" -seed="${FUZZ_SEED:-1}" \
-    -timeout="${FUZZ_TIMEOUT:-60}" -rss_limit_mb=2048 \
-    -max_len=4096 -print_final_stats=1 -artifact_prefix="$artifacts" ${dict[@]+"${dict[@]}"} \
+  # -rss_limit_mb: a memory blow-up is a crash; -max_len: documents and arguments are short.
+  # Single inputs can be slow (an sRGB-integrated plate query near grazing incidence or with a
+  # large index takes seconds to minutes: reported to the lead), so by default libFuzzer runs
+  # in fork mode, where an input running longer than FUZZ_TIMEOUT (10 s) is kept as a
+  # timeout-* artifact and listed, and fuzzing goes on; crashes and memory blow-ups stop the
+  # run and fail. FUZZ_STRICT=1: one process, and a timeout (FUZZ_TIMEOUT, 60 s) fails too.
+  if [ "${FUZZ_STRICT:-0}" = 1 ]; then
+    mode=(-timeout="${FUZZ_TIMEOUT:-60}" -print_final_stats=1)
+  else
+    mode=(-fork=1 -ignore_timeouts=1 -ignore_ooms=0 -ignore_crashes=0 -timeout_exitcode=0
+          -timeout="${FUZZ_TIMEOUT:-10}")
+  fi
+  FUZZ_FINDINGS="$findings" "$bin" -max_total_time="$secs" -seed="${FUZZ_SEED:-1}" "${mode[@]}" \
+    -rss_limit_mb=2048 -max_len=4096 -artifact_prefix="$artifacts" ${dict[@]+"${dict[@]}"} \
     "$corpus" ${seeds[@]+"${seeds[@]}"} >"$log" 2>&1 || rc=$?
+  # Executions: the final stats (one process) or the last status line "#N: cov: ..." (fork).
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
-  cov=$(grep -E '^#[0-9]+' "$log" | tail -1 | sed -n 's/.*cov: \([0-9]*\).*/\1/p')
+  [ -n "$execs" ] || execs=$(grep -E '^#[0-9]+' "$log" | tail -1 | sed -n 's/^#\([0-9]*\).*/\1/p')
+  cov=$(grep -oE 'cov: [0-9]+' "$log" | sed 's/cov: //' | sort -n | tail -1 || true)
   execs=${execs:-0}
   total=$((total + execs))
   if [ $rc -ne 0 ]; then
@@ -81,13 +92,20 @@ for t in "${targets[@]}"; do
     grep -E 'panicked|ERROR: libFuzzer|SUMMARY|Test unit written|==[0-9]+==' "$log" | head -20 || true
     echo "  full log: $log; reproduce with: $bin <artifact>"
   else
+    # In fork mode the count is of the jobs finished when the time ran out: a lower bound.
     echo "fuzz $t: $execs executions in ${secs} s, coverage $cov, no crash (log: $log)"
+  fi
+  n_slow=$(find "$artifacts" -name 'timeout-*' | wc -l)
+  if [ "$n_slow" -gt 0 ]; then
+    echo "  $t: $n_slow inputs (all runs so far) ran longer than the timeout: $artifacts/timeout-*"
   fi
   n_int=$(find "$findings" -name 'soft-*.txt' | wc -l)
   if [ "$n_int" -gt 0 ]; then
     echo "  $t: $n_int distinct inputs (all runs so far) broke the soft contract (the core's internal"
     echo "  error, or a power fraction > 1): $findings/*.txt (FUZZ_STRICT=1 makes them crashes)"
-    find "$findings" -name 'soft-*.txt' | head -3 | while read -r f; do echo "    $(head -c 300 "$f")"; done
+    for f in $(find "$findings" -name 'soft-*.txt' | sort | sed -n 1,3p); do
+      echo "    $(head -c 300 "$f")"
+    done
   fi
 done
 echo "fuzz total: $total executions over ${#targets[@]} targets"

@@ -18,6 +18,10 @@ fuzz_target!(|data: &[u8]| {
     let mut b = Bytes::new(data);
     let sub = if b.bool() { "slab" } else { "interface" };
     let text = calc_document(&mut b, sub == "slab");
+    if std::env::var_os("FUZZ_PRINT").is_some() {
+        // Replaying one input (`FUZZ_PRINT=1 TARGET FILE`): say what is run.
+        eprintln!("{sub} {text}");
+    }
     if birefringent_fuzz::known_calc(&text) {
         return;
     }

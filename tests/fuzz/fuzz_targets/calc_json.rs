@@ -25,6 +25,10 @@ fuzz_target!(|data: &[u8]| {
         None => ("interface", data),
     };
     let text = String::from_utf8_lossy(text);
+    if std::env::var_os("FUZZ_PRINT").is_some() {
+        // Replaying one input (`FUZZ_PRINT=1 TARGET FILE`): say what is run.
+        eprintln!("{sub} {text}");
+    }
     if birefringent_fuzz::known_calc(&text) {
         return;
     }

@@ -419,12 +419,14 @@ pub fn known_band(wavelength_nm: f64, fwhm_nm: f64) -> bool {
 
 /// Magnitudes beyond which the core is known (and reported) to break: an index, extinction
 /// coefficient or birefringence of magnitude above 1e6, or a thickness above 1e9 nm (1 m; the
-/// issue's range ends at 10 cm). Found: quartz with kappa_o = 6.3e70 gives a crystal reflection
-/// lobe of weight 1.4e108 (the shim then hands Mitsuba inf); a sapphire plate of thickness
-/// 4.4e262 nm overflows `panels * 8` in `spectral::integrate::integrate_set` (a panic here
-/// with overflow checks; a wrapped count in the release build). Inputs with such values are
-/// skipped unless [`strict`]; NaN, infinities, zeros, negatives and tiny values are not (they
-/// must be refused cleanly and are fuzzed in full).
+/// issue's range ends at 10 cm). Found: the band-filtered and sRGB-integrated plate size their
+/// quadrature from the index and the thickness without a bound, and abort on the allocation
+/// (calcite, kappa_e 20, birefringence 1e7, 2.44 um: 64 GB asked for) or overflow
+/// `panels * 8` in `spectral::integrate::integrate_set` (sapphire, 4.4e262 nm: a panic here
+/// with overflow checks, a wrapped count in the release build); a quartz crystal with
+/// kappa_o = 6.3e70 gives a lobe of weight 1.4e108 (a soft finding here; the shim hands
+/// Mitsuba inf). The plate entries skip such inputs unless [`strict`]; NaN, infinities,
+/// zeros, negatives and tiny values are not skipped (they must be refused cleanly).
 pub fn known_extreme(indices: &[f64], thickness_nm: f64) -> bool {
     !strict()
         && (indices.iter().any(|x| x.is_finite() && x.abs() > 1e6)
