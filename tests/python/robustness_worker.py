@@ -2,7 +2,9 @@
 thread pool size and the resident set belong to these renders alone. Prints one JSON line.
 
     robustness_worker.py threads --counts 1 2 8
-    robustness_worker.py memory --renders 6 --loads 20000 [--retain]
+    robustness_worker.py memory --renders 4 --loads 20000 [--retain]
+
+Also imported by the test module for `scene_dict` (it sets the variant itself).
 """
 
 from __future__ import annotations
@@ -108,7 +110,7 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("what", choices=["threads", "memory"])
     ap.add_argument("--counts", type=int, nargs="+", default=[1, 2, 8])
-    ap.add_argument("--renders", type=int, default=6)
+    ap.add_argument("--renders", type=int, default=4)
     ap.add_argument("--loads", type=int, default=20000)
     ap.add_argument("--retain", action="store_true", help="keep every loaded BSDF (a deliberate leak)")
     a = ap.parse_args()
@@ -121,6 +123,3 @@ def main() -> None:
 
 if __name__ == "__main__":
     main()
-else:
-    # Imported by the test module for scene_dict: the variant is the test's business.
-    pass
