@@ -16,6 +16,12 @@
 #   make clean    removes build outputs (target/, out/, Python caches, the scenes' generated
 #                 textures scenes/data/*.exr); keeps .venv/
 #   make distclean  clean, and removes .venv/ too
+#   make fuzz     make setup, then a long fuzz campaign: every libFuzzer target of tests/fuzz/
+#                 (the C ABI, the JSON calculator) for FUZZ_SECONDS each (default 600), then the
+#                 plugin-parameter fuzzer for FUZZ_SECONDS; FUZZ_STRICT=1 also fails on known,
+#                 reported defects (see tests/fuzz/run.sh)
+#   make fuzz-ci  (part of test) the same for FUZZ_CI_SECONDS per libFuzzer target (10) and
+#                 PLUGIN_FUZZ_CI_SECONDS (20) for the plugin fuzzer
 #   make bench    make setup, then the core benchmark on one core (taskset -c 0) and its plot:
 #                 bench/out/core.json, bench/out/core_error_vs_time.png (several minutes), then
 #                 make bench-scenes
@@ -65,7 +71,7 @@ MI_LDFLAGS = -shared -L$(SITE)/mitsuba -lmitsuba -L$(SITE)/drjit -ldrjit-core \
   -Wl,--exclude-libs,ALL -Wl,--gc-sections -Wl,--strip-debug -Wl,--no-undefined \
   -lpthread -ldl -lm
 
-.PHONY: help setup build venv plugin render gallery test test-rust test-python bench bench-scenes fmt lint clean distclean
+.PHONY: help setup build venv plugin render gallery test test-rust test-python fuzz fuzz-ci bench bench-scenes fmt lint clean distclean
 
 help:
 	@sed -n '3,/^$$/s/^# \{0,1\}//p' $(firstword $(MAKEFILE_LIST))
@@ -138,6 +144,7 @@ gallery: setup
 test: setup
 	$(MAKE) --no-print-directory test-rust
 	$(MAKE) --no-print-directory test-python
+	$(MAKE) --no-print-directory fuzz-ci
 
 test-rust:
 	$(CARGO) test --release
@@ -150,6 +157,26 @@ test-python: plugin
 	  echo "$(PYTESTS): no Python test files; nothing to run"; rc=0; \
 	fi; \
 	exit $$rc
+
+## ---- fuzzing --------------------------------------------------------------------------
+
+# tests/fuzz/run.sh builds the libFuzzer targets with the stable toolchain (libfuzzer-sys pinned
+# in tests/fuzz/Cargo.toml/Cargo.lock, coverage by rustc's stable sancov flags) into
+# target/fuzz/ and runs each for the given seconds with a fixed seed; crashing inputs are kept
+# in target/fuzz/artifacts/. tests/fuzz/plugin_fuzz.py fuzzes the plugin parameters through
+# mi.load_dict in every supported variant, one worker subprocess at a time (a segfault is a
+# finding, its input kept in target/fuzz/plugin/). Both print executions and exit 1 on a crash.
+FUZZ_SECONDS ?= 600
+FUZZ_CI_SECONDS ?= 10
+PLUGIN_FUZZ_CI_SECONDS ?= 20
+
+fuzz: setup
+	CARGO=$(CARGO) tests/fuzz/run.sh $(FUZZ_SECONDS)
+	$(VPY) tests/fuzz/plugin_fuzz.py --seconds $(FUZZ_SECONDS) $(if $(filter 1,$(FUZZ_STRICT)),--strict)
+
+fuzz-ci: plugin
+	CARGO=$(CARGO) tests/fuzz/run.sh $(FUZZ_CI_SECONDS)
+	$(VPY) tests/fuzz/plugin_fuzz.py --seconds $(PLUGIN_FUZZ_CI_SECONDS)
 
 ## ---- benchmark ------------------------------------------------------------------------
 

@@ -1,0 +1,28 @@
+"""The plugin-parameter fuzzer (tests/fuzz/plugin_fuzz.py) sees a crash: its worker process is
+made to segfault on its first case (--inject-crash), and the fuzzer must report that case as a
+finding, keep it, go on with the next cases in a new worker, and exit 1. Without this, a
+fuzzer whose crash detection is broken would pass forever."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+FUZZER = Path(__file__).resolve().parents[1] / "fuzz" / "plugin_fuzz.py"
+
+
+def test_plugin_fuzzer_reports_a_segfault(tmp_path):
+    out = subprocess.run(
+        [sys.executable, str(FUZZER), "--seconds", "6", "--variants", "scalar_spectral",
+         "--inject-crash", "--out", str(tmp_path), "--queries", "2"],
+        capture_output=True, text=True, timeout=300)
+    assert out.returncode == 1, out.stdout + out.stderr
+    found = sorted(tmp_path.glob("finding-scalar_spectral-seed1-case0.json"))
+    assert found, out.stdout
+    finding = json.loads(found[0].read_text())
+    assert finding["finding"].startswith("CRASH worker exit -11"), finding  # SIGSEGV
+    # It went on after the crash: later cases ran in a new worker.
+    line = next(x for x in out.stdout.splitlines() if x.startswith("plugin fuzz scalar_spectral:"))
+    assert int(line.split(":")[1].split()[0]) > 1, line
