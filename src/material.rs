@@ -5,6 +5,10 @@ use crate::error::{Error, Result};
 use crate::medium::check_index;
 use num_complex::Complex64 as C64;
 
+/// Vacuum wavelengths accepted (nm): X-rays to millimetre waves; the optics is continuum
+/// electrodynamics, so anything beyond is outside the model (and outside f64's comfort).
+pub const WAVELENGTH_RANGE: (f64, f64) = (1.0, 1e6);
+
 /// One principal index: `n(λ) + iκ`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Index {
@@ -97,10 +101,13 @@ impl Material {
     /// stress: `n_e − n_o = C (σ₁ − σ₂)` on an isotropic material). Fails (naming the
     /// parameter) if the result is not a valid index.
     pub fn indices(&self, lambda_nm: f64, birefringence: f64) -> Result<(C64, C64)> {
-        if !(lambda_nm.is_finite() && lambda_nm > 0.0) {
+        if !(WAVELENGTH_RANGE.0..=WAVELENGTH_RANGE.1).contains(&lambda_nm) {
             return Err(Error::new(
                 "wavelength_nm",
-                format!("must be > 0, got {lambda_nm}"),
+                format!(
+                    "must be within [{}, {}] nm, got {lambda_nm}",
+                    WAVELENGTH_RANGE.0, WAVELENGTH_RANGE.1
+                ),
             ));
         }
         if !birefringence.is_finite() {

@@ -109,7 +109,14 @@ pub fn check_clear_index(parameter: &str, eta: C64) -> Result<C64> {
     Ok(eta)
 }
 
-/// Validates one complex index `n + iκ`: finite, `n > 0`, `κ >= 0`.
+/// Range of the real part of an index (every optical material lies well inside; beyond, the
+/// results leave the range of the renderer's single-precision numbers).
+pub const INDEX_RANGE: (f64, f64) = (1e-3, 1e3);
+/// Largest extinction coefficient `κ` (metals reach ~100 in the infrared).
+pub const KAPPA_MAX: f64 = 1e3;
+
+/// Validates one complex index `n + iκ`: finite, `n` within [`INDEX_RANGE`], `0 <= κ <=`
+/// [`KAPPA_MAX`].
 pub fn check_index(parameter: &str, eta: C64) -> Result<C64> {
     if !eta.re.is_finite() || !eta.im.is_finite() {
         return Err(Error::new(parameter, "must be finite"));
@@ -118,6 +125,24 @@ pub fn check_index(parameter: &str, eta: C64) -> Result<C64> {
         return Err(Error::new(
             parameter,
             format!("real part of the index must be > 0, got {}", eta.re),
+        ));
+    }
+    if !(INDEX_RANGE.0..=INDEX_RANGE.1).contains(&eta.re) {
+        return Err(Error::new(
+            parameter,
+            format!(
+                "real part of the index must be within [{}, {}], got {}",
+                INDEX_RANGE.0, INDEX_RANGE.1, eta.re
+            ),
+        ));
+    }
+    if eta.im > KAPPA_MAX {
+        return Err(Error::new(
+            parameter,
+            format!(
+                "extinction coefficient (imaginary part) must be <= {KAPPA_MAX}, got {}",
+                eta.im
+            ),
         ));
     }
     if eta.im < 0.0 {

@@ -16,7 +16,7 @@ use crate::lobes::{scatter, Event, Lobe};
 use crate::material::Material;
 use crate::medium::{check_clear_index, Uniaxial};
 use crate::modes::ModeKind;
-use crate::slab::{SlabMueller, Want};
+use crate::slab::{SlabMueller, Want, THICKNESS_MAX_NM};
 use crate::spectral::integrate::{etalon_sum, integrate, integrate_set, narrow_band, Output};
 use crate::spectral::plate::Plate;
 use crate::spectral::weights::{gaussians, Gaussian, WeightSet};
@@ -294,10 +294,13 @@ impl PlateQuery {
             axis: Uniaxial::new(C64::new(1.0, 0.0), C64::new(1.5, 0.0), axis)?.axis,
             thickness_nm,
         };
-        if !(thickness_nm.is_finite() && thickness_nm >= 0.0) {
+        if !((0.0..=THICKNESS_MAX_NM).contains(&thickness_nm)) {
             return Err(Error::new(
                 "thickness",
-                format!("must be finite and >= 0, got {} µm", thickness_nm * 1e-3),
+                format!(
+                    "must be within [0, 1e6] µm (1 m), got {} µm",
+                    thickness_nm * 1e-3
+                ),
             ));
         }
         Ok(PlateQuery {
@@ -474,7 +477,7 @@ fn physical_plate(
             .bands()
             .into_iter()
             .map(|(wavelength_nm, fwhm_nm)| {
-                check_bandwidth(fwhm_nm)?;
+                check_bandwidth(fwhm_nm, wavelength_nm)?;
                 if fwhm_nm == 0.0 {
                     q.plate
                         .mueller_at(wavelength_nm, &frame, beta, want, q.output)
@@ -524,7 +527,7 @@ fn isotropic_plate(
             let mut incoherent = None;
             let mut ms = Vec::new();
             for (wavelength_nm, fwhm_nm) in spectrum.bands() {
-                check_bandwidth(fwhm_nm)?;
+                check_bandwidth(fwhm_nm, wavelength_nm)?;
                 let m = if fwhm_nm == 0.0 {
                     etalon.mueller(wavelength_nm, q.want, q.output)
                 } else {
@@ -566,14 +569,15 @@ fn isotropic_plate(
     })
 }
 
-/// `filter_bandwidth` must be finite and `>= 0`.
-fn check_bandwidth(fwhm_nm: f64) -> Result<()> {
-    if fwhm_nm.is_finite() && fwhm_nm >= 0.0 {
+/// `filter_bandwidth` must be finite, `>= 0` and at most a quarter of the wavelength (a
+/// Gaussian in wavenumber then keeps all its weight far from `k = 0`).
+fn check_bandwidth(fwhm_nm: f64, wavelength_nm: f64) -> Result<()> {
+    if fwhm_nm.is_finite() && fwhm_nm >= 0.0 && fwhm_nm <= 0.25 * wavelength_nm {
         Ok(())
     } else {
         Err(Error::new(
             "filter_bandwidth",
-            format!("must be >= 0, got {fwhm_nm}"),
+            format!("must be within [0, wavelength / 4] (nm), got {fwhm_nm} at {wavelength_nm} nm"),
         ))
     }
 }

@@ -23,6 +23,10 @@ use crate::mueller;
 use nalgebra::{Matrix2, Matrix4};
 use num_complex::Complex64 as C64;
 
+/// Largest plate thickness (nm): 1 m. Beyond, the phases `k d q` (~1e7 rad per metre at
+/// 550 nm) lose the digits that interference needs.
+pub const THICKNESS_MAX_NM: f64 = 1e9;
+
 /// A uniaxial plate between an isotropic top (light arrives from there) and bottom medium.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Slab {
@@ -89,10 +93,10 @@ pub struct SlabMueller {
 impl Slab {
     /// A validated slab.
     pub fn new(top: C64, layer: Uniaxial, bottom: C64, thickness_nm: f64) -> Result<Self> {
-        if !(thickness_nm.is_finite() && thickness_nm >= 0.0) {
+        if !((0.0..=THICKNESS_MAX_NM).contains(&thickness_nm)) {
             return Err(Error::new(
                 "thickness",
-                format!("must be finite and >= 0, got {thickness_nm}"),
+                format!("must be within [0, 1e9] nm (1 m), got {thickness_nm}"),
             ));
         }
         Ok(Slab {

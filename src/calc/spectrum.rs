@@ -79,10 +79,10 @@ pub fn run(input: &Value, fields: &[&str], spec: &Value) -> Result<Value> {
                 )
             }
             (None, Some(b)) => {
-                if b < 0.0 {
+                if !(0.0..=0.25 * q.wavelength_nm).contains(&b) {
                     return Err(Error::new(
                         "spectrum.bandwidth_nm",
-                        format!("must be >= 0, got {b}"),
+                        format!("must be within [0, wavelength_nm / 4], got {b}"),
                     ));
                 }
                 let m = band(&q, b, quad, step)?;

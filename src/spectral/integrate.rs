@@ -433,11 +433,12 @@ pub fn integrate_set(
     // Two thirds of an oscillation of the fastest significant order per 8-point Gauss–Legendre
     // panel: the rule integrates exp(i ω x) over that span to ~1e-12 (and over one period to
     // 9e-11; the estimate of the fastest order can be low by a few tens of per cent).
-    let panels = ((1.5 * oscillations).ceil() as usize).max(8);
-    if panels * 8 > SHARED_NODES_MAX {
+    // (Compared in floating point first: a huge plate must not overflow the node count.)
+    if !(12.0 * oscillations <= SHARED_NODES_MAX as f64) {
         let one = |c: usize| integrate(plate, frame, beta, bands[c], want, output);
         return Ok([one(0)?, one(1)?, one(2)?]);
     }
+    let panels = ((1.5 * oscillations).ceil() as usize).max(8);
     // The blocks at each node: fixed without dispersion; else interpolated across the band
     // (checked; exact at every node where the interpolant is refused).
     let exact = |k: f64| -> Result<SlabBlocks> {
@@ -586,6 +587,9 @@ fn band_sum(
     }
 }
 
+/// Most plate evaluations [`quadrature`] accepts.
+pub const QUADRATURE_MAX: usize = 10_000_000;
+
 /// Reference: `∫ w(λ) M(λ) dλ` of the exact slab by the trapezoid rule on `[lo, hi]` with
 /// `step_nm`, `weight` per nm (normalise it yourself). Slow; for validation.
 pub fn quadrature(
@@ -600,7 +604,16 @@ pub fn quadrature(
     if !(step_nm > 0.0 && step_nm.is_finite()) {
         return Err(Error::new("step_nm", "must be > 0"));
     }
-    let n = ((hi - lo) / step_nm).ceil().max(1.0) as usize;
+    let count = ((hi - lo) / step_nm).ceil().max(1.0);
+    if !(count <= QUADRATURE_MAX as f64) {
+        return Err(Error::new(
+            "step_nm",
+            format!(
+                "too small: {count:.3e} plate evaluations over [{lo}, {hi}] nm (at most {QUADRATURE_MAX:.0e}; minutes of run time)"
+            ),
+        ));
+    }
+    let n = count as usize;
     let h = (hi - lo) / n as f64;
     let fixed = if plate.is_dispersive() {
         None
