@@ -56,6 +56,19 @@ pub fn read_incidence(f: &mut Fields, surface: &Surface, allow_inside: bool) -> 
             }
             surface.beta(incident, &frame, t.to_radians())
         }
+        // From outside the incident wave must propagate: beta < ext_ior (beyond, it is
+        // evanescent and carries no power to take fractions of).
+        (None, Some(b))
+            if matches!(incident, Incident::Outside) && b >= surface.exterior.eta_o.re =>
+        {
+            return Err(Error::new(
+                "beta",
+                format!(
+                    "must be < ext_ior ({}) for light from outside, got {b}",
+                    surface.exterior.eta_o.re
+                ),
+            ))
+        }
         (None, Some(b)) if b >= 0.0 => C64::new(b, 0.0),
         (None, Some(b)) => return Err(Error::new("beta", format!("must be >= 0, got {b}"))),
         (Some(_), Some(_)) => return Err(Error::new("beta", "give theta_deg or beta, not both")),

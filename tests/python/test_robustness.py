@@ -94,8 +94,10 @@ RENDER_TIME_CASES = {
                            "thickness": {"type": "checkerboard", "color0": -4.0, "color1": 5.0}},
     "negative_eta_e": {"type": "thinbirefringent", "eta_o": 1.5, "eta_e": 1.6, "thickness": 3.0,
                        "birefringence": {"type": "checkerboard", "color0": -2.0, "color1": 2.0}},
+    # 1.5 m squares: beyond the core's 1 m limit (refused at those texels; the mean, 0.75 m,
+    # passes the load-time check).
     "huge_thickness": {"type": "thinbirefringent", "material": "calcite",
-                       "thickness": {"type": "checkerboard", "color0": 3e38, "color1": 1.0}},
+                       "thickness": {"type": "checkerboard", "color0": 1.5e6, "color1": 1.0}},
 }
 RENDER_TIME_RUNS = [(v, n) for v in ["scalar_spectral", POLARIZED] for n in sorted(RENDER_TIME_CASES)]
 RENDER_TIME_RUNS += [("scalar_rgb", "negative_thickness"), ("scalar_rgb", "huge_thickness")]
@@ -114,7 +116,7 @@ def test_invalid_texture_values_at_render_time_give_a_finite_image(var, name):
     # 0.5 of the pixels; a bound of 0.1 for the pixels at the squares' edge and sample noise).
     # Elsewhere light comes through (the plate transmits ~0.9 of it).
     dark = float(np.mean(img.mean(axis=2) < 0.05))
-    expected_dark = 0.0 if name == "huge_thickness" else 0.5
+    expected_dark = 0.5
     assert abs(dark - expected_dark) <= 0.1, (dark, expected_dark)
     lit = img.mean(axis=2)[img.mean(axis=2) >= 0.05]
     assert lit.size and np.median(lit) > 0.5, np.median(lit)
