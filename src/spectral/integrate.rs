@@ -434,7 +434,7 @@ pub fn integrate_set(
     // panel: the rule integrates exp(i ω x) over that span to ~1e-12 (and over one period to
     // 9e-11; the estimate of the fastest order can be low by a few tens of per cent).
     // (Compared in floating point first: a huge plate must not overflow the node count.)
-    if !(12.0 * oscillations <= SHARED_NODES_MAX as f64) {
+    if oscillations.is_nan() || 12.0 * oscillations > SHARED_NODES_MAX as f64 {
         let one = |c: usize| integrate(plate, frame, beta, bands[c], want, output);
         return Ok([one(0)?, one(1)?, one(2)?]);
     }
@@ -605,7 +605,7 @@ pub fn quadrature(
         return Err(Error::new("step_nm", "must be > 0"));
     }
     let count = ((hi - lo) / step_nm).ceil().max(1.0);
-    if !(count <= QUADRATURE_MAX as f64) {
+    if count.is_nan() || count > QUADRATURE_MAX as f64 {
         return Err(Error::new(
             "step_nm",
             format!(
