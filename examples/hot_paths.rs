@@ -1,0 +1,167 @@
+//! Instruction counts of the per-query hot paths of the plugins, for `valgrind --tool=callgrind`
+//! (counts are repeatable whatever else the machine does, unlike times):
+//!
+//! ```text
+//! cargo build --release --example hot_paths
+//! valgrind --tool=callgrind target/release/examples/hot_paths <case> 1     # set-up alone
+//! valgrind --tool=callgrind target/release/examples/hot_paths <case> 1001  # + 1000 queries
+//! ```
+//! The difference of the two totals over 1000 is the cost of one query. Cases: `interface`
+//! (air → calcite-like crystal, 4x4 solve), `crystal_iso` / `crystal_calcite` (bulk surface
+//! lobes, Radiance), `plate_*` (`plate_lobes`, Radiance, both lobes: isotropic 1 mm plate
+//! exact / 4 nm band / sRGB, quartz 20 um, 60 um, calcite 1 mm and a 3 mm photoelastic-like
+//! plate in a 4 nm band, a 0.5 um lithium niobate film in sRGB). Directions: 64 on a spiral up
+//! to `THETA_MAX` degrees from the normal (default 80).
+
+use birefringent::interface::Interface;
+use birefringent::material::Material;
+use birefringent::medium::Uniaxial;
+use birefringent::sampling::{crystal_lobes, plate_lobes, PlateQuery, Spectrum, Transport};
+use birefringent::spectral::weights::WeightSet;
+use birefringent::surface::Surface;
+use birefringent::C64;
+use nalgebra::Vector3;
+use std::hint::black_box;
+
+fn dirs(n: usize) -> Vec<Vector3<f64>> {
+    (0..n)
+        .map(|i| {
+            let max: f64 = std::env::var("THETA_MAX")
+                .ok()
+                .and_then(|v| v.parse().ok())
+                .unwrap_or(80.0);
+            let t = max.to_radians() * (i as f64 + 0.5) / n as f64;
+            let p = 2.399963 * i as f64;
+            Vector3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos())
+        })
+        .collect()
+}
+
+fn main() {
+    let a: Vec<String> = std::env::args().collect();
+    let case = a[1].as_str();
+    let n: usize = a[2].parse().unwrap();
+    let ds = dirs(64);
+    let c = |x: f64| C64::new(x, 0.0);
+    match case {
+        "interface" => {
+            let air = Uniaxial::isotropic(c(1.0)).unwrap();
+            let xs: Vec<Uniaxial> = ds
+                .iter()
+                .map(|d| Uniaxial::new(c(1.658), c(1.486), *d).unwrap())
+                .collect();
+            for i in 0..n {
+                black_box(
+                    Interface::new(&air, &xs[i % 64], c(0.6 * (i % 7) as f64 / 7.0)).unwrap(),
+                );
+            }
+        }
+        "crystal_iso" | "crystal_calcite" => {
+            let (o, e) = if case == "crystal_iso" {
+                (1.5, 1.5)
+            } else {
+                (1.658, 1.486)
+            };
+            let s = Surface::new(
+                c(1.0),
+                Uniaxial::new(c(o), c(e), Vector3::new(1.0, 0.3, 0.2)).unwrap(),
+            )
+            .unwrap();
+            for i in 0..n {
+                black_box(crystal_lobes(&s, ds[i % 64], Transport::Radiance).unwrap());
+            }
+        }
+        _ => {
+            let (mat, th, spec) = match case {
+                "plate_iso_band" => (
+                    Material::constant(c(1.5), c(1.5)).unwrap(),
+                    1e6,
+                    Spectrum::Band {
+                        wavelength_nm: 550.0,
+                        fwhm_nm: 4.0,
+                    },
+                ),
+                "plate_iso_exact" => (
+                    Material::constant(c(1.5), c(1.5)).unwrap(),
+                    1e6,
+                    Spectrum::Band {
+                        wavelength_nm: 550.0,
+                        fwhm_nm: 0.0,
+                    },
+                ),
+                "plate_iso_rgb" => (
+                    Material::constant(c(1.5), c(1.5)).unwrap(),
+                    1e6,
+                    Spectrum::Weights(WeightSet::SrgbD65),
+                ),
+                "plate_quartz_band" => (
+                    Material::named("quartz", 0.0, 0.0).unwrap(),
+                    2e4,
+                    Spectrum::Band {
+                        wavelength_nm: 550.0,
+                        fwhm_nm: 4.0,
+                    },
+                ),
+                "plate_quartz_exact" => (
+                    Material::named("quartz", 0.0, 0.0).unwrap(),
+                    2e4,
+                    Spectrum::Band {
+                        wavelength_nm: 550.0,
+                        fwhm_nm: 0.0,
+                    },
+                ),
+                "plate_quartz_rgb" => (
+                    Material::named("quartz", 0.0, 0.0).unwrap(),
+                    2e4,
+                    Spectrum::Weights(WeightSet::SrgbD65),
+                ),
+                "plate_quartz60_band" => (
+                    Material::named("quartz", 0.0, 0.0).unwrap(),
+                    6e4,
+                    Spectrum::Band {
+                        wavelength_nm: 550.0,
+                        fwhm_nm: 4.0,
+                    },
+                ),
+                "plate_calcite_thick_band" => (
+                    Material::named("calcite", 0.0, 0.0).unwrap(),
+                    1e6,
+                    Spectrum::Band {
+                        wavelength_nm: 550.0,
+                        fwhm_nm: 4.0,
+                    },
+                ),
+                "plate_stress_band" => (
+                    Material::constant(c(1.5), c(1.5005)).unwrap(),
+                    3e6,
+                    Spectrum::Band {
+                        wavelength_nm: 550.0,
+                        fwhm_nm: 4.0,
+                    },
+                ),
+                "plate_film_rgb" => (
+                    Material::named("linbo3", 0.0, 0.0).unwrap(),
+                    500.0,
+                    Spectrum::Weights(WeightSet::SrgbD65),
+                ),
+                _ => panic!("unknown case"),
+            };
+            let intensity = case.ends_with("rgb");
+            let q = PlateQuery::new(
+                mat,
+                0.0,
+                c(1.0),
+                c(1.0),
+                Vector3::new(1.0, 1.0, 0.0),
+                th,
+                true,
+                true,
+                intensity,
+            )
+            .unwrap();
+            for i in 0..n {
+                black_box(plate_lobes(&q, &spec, ds[i % 64], Transport::Radiance).unwrap());
+            }
+        }
+    }
+}
