@@ -318,7 +318,7 @@ fn call(
 fuzz_target!(|data: &[u8]| {
     birefringent_fuzz::set_input(data);
     let mut b = Bytes::new(data);
-    let entry = b.u8() % 6;
+    let entry = b.u8() % 7;
     if entry == 5 {
         // SAFETY: no arguments; a static NUL-terminated string.
         let v = unsafe { std::ffi::CStr::from_ptr(bfr_version()) };
@@ -459,6 +459,40 @@ fuzz_target!(|data: &[u8]| {
                     // SAFETY: out holds 2 lobes or is null.
                     unsafe {
                         bfr_plate_lobes(mp, gp, lambda, fwhm, wp, transport, flags, out, mp_, ml)
+                    }
+                },
+            );
+        }
+        6 => {
+            // Several wavelengths at once: counts 0..=6 (0, 5 and 6 must be refused), a null
+            // wavelength array now and then.
+            let count = (b.u8() % 7) as usize;
+            let fwhm = b.f64();
+            let waves: Vec<f64> = (0..count.max(1)).map(|_| b.f64()).collect();
+            let wv = if b.u8() == 0 {
+                ptr::null()
+            } else {
+                waves.as_ptr()
+            };
+            let a = args(format!("wavelengths {waves:?} (count {count}), fwhm {fwhm}"));
+            call(
+                &mut b,
+                &a,
+                Expect {
+                    n_out: 2 * count.max(1),
+                    max_component: 1,
+                    intensity_only,
+                    rgb: false,
+                    importance_plate: importance,
+                    crystal_importance: false,
+                },
+                |out, mp_, ml| {
+                    // SAFETY: out holds 2 x max(count, 1) lobes or is null; wv holds
+                    // max(count, 1) values or is null.
+                    unsafe {
+                        bfr_plate_lobes_n(
+                            mp, gp, wv, count, fwhm, wp, transport, flags, out, mp_, ml,
+                        )
                     }
                 },
             );
