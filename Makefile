@@ -18,8 +18,8 @@
 #   make distclean  clean, and removes .venv/ too
 #   make fuzz     make setup, then a long fuzz campaign: every libFuzzer target of tests/fuzz/
 #                 (the C ABI, the JSON calculator) for FUZZ_SECONDS each (default 600), then the
-#                 plugin-parameter fuzzer for FUZZ_SECONDS; FUZZ_STRICT=1 also fails on known,
-#                 reported defects (see tests/fuzz/run.sh)
+#                 plugin-parameter fuzzer for FUZZ_SECONDS; FUZZ_STRICT=1 also fails on soft
+#                 findings (an internal-error status, a power fraction > 1; see tests/fuzz/run.sh)
 #   make fuzz-ci  (part of test) the same for FUZZ_CI_SECONDS per libFuzzer target (10) and
 #                 PLUGIN_FUZZ_CI_SECONDS (20) for the plugin fuzzer
 #   make bench    make setup, then the core benchmark on one core (taskset -c 0) and its plot:

@@ -23,8 +23,8 @@ dictionary (`--case` replays one).
 
 A case that runs longer than SLOW seconds is listed as slow (single sRGB-integrated or
 band-filtered plate queries can take seconds: reported to the lead); one running past --hang is
-a hang (a finding). Findings of known, reported core defects (see `known_finding`) are listed
-as KNOWN and do not fail unless --strict.
+a hang (a finding). (Extreme magnitudes that once crashed the renderer or handed it inf are
+now refused by the core at load, with a message naming the parameter.)
 
 Exit status 0 if no case crashed, hung or broke the contract, 1 otherwise (the cases are
 written to --out as JSON, with a command to replay each).
@@ -136,43 +136,6 @@ def numbers(v) -> list[float]:
     if isinstance(v, dict):
         return [x for w in v.values() for x in numbers(w)]
     return []
-
-
-def extreme(d: dict) -> list[str]:
-    """Parameters of magnitude beyond 1e6 (an index, an extinction coefficient, a birefringence
-    (times its scale), or a thickness in um (times its scale)): the bound of the libFuzzer
-    targets' known_extreme (tests/fuzz/src/lib.rs)."""
-    def biggest(key, scale_key=None):
-        xs = [abs(x) for x in numbers(d.get(key))]
-        scale = abs(d.get(scale_key, 1.0)) if isinstance(d.get(scale_key, 1.0), float) else 1.0
-        return max(xs, default=0.0) * (scale if math.isfinite(scale) else 1.0)
-    out = [k for k in ("eta_o", "eta_e", "kappa_o", "kappa_e") if biggest(k) > 1e6]
-    out += [k for k, sk in (("birefringence", "birefringence_scale"), ("thickness", "thickness_scale"))
-            if biggest(k, sk) > 1e6]
-    # Indices the core accepts (> 0) but no medium has: the radiance factor (n_in / n_out)^2
-    # reaches 1e128 (ext_ior 2.5e-65), finite in double, inf once the shim converts to float.
-    out += [k for k in ("eta_o", "eta_e", "ext_ior", "exit_ior")
-            if any(0.0 < abs(x) < 1e-3 for x in numbers(d.get(k)))]
-    return out
-
-
-def known_finding(d: dict, what: str) -> str | None:
-    """Why a finding is a known, reported defect (listed, not failing unless --strict), or None.
-
-    Reported to the lead, at magnitudes beyond 1e6 (the libFuzzer targets skip the same) or
-    indices below 1e-3:
-    - huge extinction coefficients break the core's arithmetic (quartz with kappa_o = 6.3e70
-      gives a crystal reflection lobe of weight 1.4e108, finite in double), and the shim
-      converts such finite doubles to float without a range check, so Mitsuba receives inf;
-    - the band-filtered plate sizes its quadrature from the index and the thickness without a
-      bound: its cost grows linearly with them (calcite, kappa_e 20, birefringence 1e4: 15 s
-      per query) and at birefringence 1e7 it asks for 64 GB, an allocation failure that aborts
-      the renderer (SIGABRT, the worker's exit -6).
-    Remove once the core refuses or bounds them."""
-    if not (what.startswith("FAIL sample weight not finite") or what.startswith("CRASH worker exit -6")):
-        return None
-    huge = extreme(d)
-    return f"|{', '.join(huge)}| > 1e6: reported core defect (see known_finding)" if huge else None
 
 
 def keys_of(d) -> set[str]:
@@ -353,12 +316,6 @@ def run(args) -> int:
     for variant, idx, took in slow:
         print(f"SLOW {variant} case {idx}: {took:.1f} s (not a failure; a hang is > {args.hang} s)\n"
               f"  dict: {describe(case(args.seed, idx))[:300]}")
-    known = [(v, i, w, known_finding(case(args.seed, i), w)) for v, i, w in findings]
-    findings = [(v, i, w) for v, i, w, k in known if not k or args.strict]
-    for variant, idx, what, why in known:
-        if why and not args.strict:
-            print(f"KNOWN {variant} case {idx}: {what[:200]}\n  dict: {describe(case(args.seed, idx))[:300]}\n"
-                  f"  known because: {why}")
     for variant, idx, what in findings:
         d = case(args.seed, idx)
         path = out / f"finding-{variant}-seed{args.seed}-case{idx}.json"
@@ -367,9 +324,8 @@ def run(args) -> int:
                                     "replay": replay}, indent=1))
         print(f"FINDING {variant} case {idx}: {what[:300]}\n  dict: {describe(d)[:300]}\n"
               f"  replay: {replay}\n  kept: {path}")
-    n = sum(c["loaded"] + c["refused"] for c in totals.values()) + len(known)
-    n_known = len(known) - len(findings)
-    print(f"plugin fuzz total: {n} cases, {len(findings)} findings, {n_known} known, {len(slow)} slow")
+    n = sum(c["loaded"] + c["refused"] for c in totals.values()) + len(findings)
+    print(f"plugin fuzz total: {n} cases, {len(findings)} findings, {len(slow)} slow")
     return 1 if findings else 0
 
 
@@ -382,7 +338,7 @@ def main() -> int:
     ap.add_argument("--queries", type=int, default=16, help="random queries per loaded BSDF")
     ap.add_argument("--out", default=str(Path(__file__).resolve().parents[2] / "target/fuzz/plugin"))
     ap.add_argument("--hang", type=float, default=300.0, help="seconds after which one case is a hang")
-    ap.add_argument("--strict", action="store_true", help="known findings fail too")
+    ap.add_argument("--strict", action="store_true", help="accepted for compatibility; every finding fails")
     ap.add_argument("--case", type=int, help="replay one case in this process and print it")
     ap.add_argument("--inject-crash", action="store_true", help="self-check: first worker segfaults")
     ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)

@@ -358,24 +358,6 @@ fuzz_target!(|data: &[u8]| {
         _ => (b.u8() % 8) as i32,
     };
     let importance = transport == BFR_IMPORTANCE;
-    // Known, reported aborts of the plate at extreme magnitudes (see known_extreme; the crystal
-    // and material entries are fuzzed in full): skipped unless FUZZ_STRICT=1.
-    let indices = [
-        d.eta_o.re,
-        d.eta_o.im,
-        d.eta_e.re,
-        d.eta_e.im,
-        d.kappa_o,
-        d.kappa_e,
-        g.ext_ior,
-        g.exit_ior,
-        g.birefringence,
-    ];
-    if entry >= 3 && birefringent_fuzz::known_extreme(&indices, g.thickness_nm) {
-        // SAFETY: m came from bfr_material_new and is not used afterwards.
-        unsafe { bfr_material_free(m) };
-        return;
-    }
     let name = if d.material.is_null() {
         None
     } else {
@@ -437,12 +419,6 @@ fuzz_target!(|data: &[u8]| {
         }
         3 => {
             let (lambda, fwhm) = (b.f64(), b.f64());
-            // A known, reported abort (see known_band): skipped unless FUZZ_STRICT=1.
-            if birefringent_fuzz::known_band(lambda, fwhm) {
-                // SAFETY: m came from bfr_material_new and is not used afterwards.
-                unsafe { bfr_material_free(m) };
-                return;
-            }
             let a = args(format!("wavelength {lambda}, fwhm {fwhm}"));
             call(
                 &mut b,
