@@ -104,7 +104,7 @@ impl Etalon {
     }
 
     /// Mueller matrices averaged over the unit-mass Gaussian band `g` (in wavenumber);
-    /// `None` if the series would need more than [`MAX_TERMS`] terms.
+    /// `None` if the series would need more than `MAX_TERMS` (4096) terms.
     pub fn band(&self, g: &Gaussian, want: Want, output: Output) -> Option<SlabMueller> {
         let h = self.round_trip(g.mu);
         let a = 2.0 * (g.sigma * self.thickness_nm * self.w).powi(2);

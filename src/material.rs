@@ -9,6 +9,21 @@ use num_complex::Complex64 as C64;
 /// electrodynamics, so anything beyond is outside the model (and outside f64's comfort).
 pub const WAVELENGTH_RANGE: (f64, f64) = (1.0, 1e6);
 
+/// Fails (naming `wavelength_nm`) outside [`WAVELENGTH_RANGE`] or for NaN.
+pub fn check_wavelength(lambda_nm: f64) -> Result<()> {
+    if (WAVELENGTH_RANGE.0..=WAVELENGTH_RANGE.1).contains(&lambda_nm) {
+        Ok(())
+    } else {
+        Err(Error::new(
+            "wavelength_nm",
+            format!(
+                "must be within [{}, {}] nm, got {lambda_nm}",
+                WAVELENGTH_RANGE.0, WAVELENGTH_RANGE.1
+            ),
+        ))
+    }
+}
+
 /// One principal index: `n(λ) + iκ`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Index {
@@ -101,15 +116,7 @@ impl Material {
     /// stress: `n_e − n_o = C (σ₁ − σ₂)` on an isotropic material). Fails (naming the
     /// parameter) if the result is not a valid index.
     pub fn indices(&self, lambda_nm: f64, birefringence: f64) -> Result<(C64, C64)> {
-        if !(WAVELENGTH_RANGE.0..=WAVELENGTH_RANGE.1).contains(&lambda_nm) {
-            return Err(Error::new(
-                "wavelength_nm",
-                format!(
-                    "must be within [{}, {}] nm, got {lambda_nm}",
-                    WAVELENGTH_RANGE.0, WAVELENGTH_RANGE.1
-                ),
-            ));
-        }
+        check_wavelength(lambda_nm)?;
         if !birefringence.is_finite() {
             return Err(Error::new("birefringence", "must be finite"));
         }

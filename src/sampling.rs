@@ -13,7 +13,7 @@ use crate::error::{Error, Result};
 use crate::frame::PlaneFrame;
 use crate::isotropic;
 use crate::lobes::{scatter, Event, Lobe};
-use crate::material::Material;
+use crate::material::{check_wavelength, Material};
 use crate::medium::{check_clear_index, Uniaxial};
 use crate::modes::ModeKind;
 use crate::slab::{SlabMueller, Want, THICKNESS_MAX_NM};
@@ -329,7 +329,7 @@ impl PlateQuery {
 
 /// The plate's lobes seen from `wi`, one `[reflection, transmission]` pair per spectral
 /// channel (one for [`Spectrum::Band`]). An isotropic plate ([`Plate::etalon`]) is solved once
-/// for both lobes (see [`isotropic_plate`]).
+/// for both lobes (by reciprocity; `isotropic_plate` in this module).
 pub fn plate_lobes(
     q: &PlateQuery,
     spectrum: &Spectrum,
@@ -527,6 +527,7 @@ fn isotropic_plate(
             let mut incoherent = None;
             let mut ms = Vec::new();
             for (wavelength_nm, fwhm_nm) in spectrum.bands() {
+                check_wavelength(wavelength_nm)?;
                 check_bandwidth(fwhm_nm, wavelength_nm)?;
                 let m = if fwhm_nm == 0.0 {
                     etalon.mueller(wavelength_nm, q.want, q.output)

@@ -397,3 +397,33 @@ fn several_wavelengths_in_one_query_equal_single_queries() {
     // every wavelength, whose coherent terms are below e^-40 (~4e-18) of the leading ones.
     assert!(worst < 1e-14, "{worst:e}");
 }
+
+/// The shared isotropic path validates the wavelengths as the general path does.
+#[test]
+fn isotropic_plate_refuses_invalid_wavelengths() {
+    use birefringent::sampling::{plate_lobes, PlateQuery, Spectrum, Transport};
+    let q = PlateQuery::new(
+        Material::constant(re(1.5), re(1.5)).unwrap(),
+        0.0,
+        re(1.0),
+        re(1.0),
+        Vector3::z(),
+        1e3,
+        true,
+        true,
+        false,
+    )
+    .unwrap();
+    let wi = Vector3::new(0.3, 0.1, 0.948_683_298_050_513_8);
+    for (wavelength_nm, fwhm_nm) in [(f64::NAN, 0.0), (0.5, 0.0), (2e6, 4.0), (550.0, 200.0)] {
+        let s = Spectrum::Band {
+            wavelength_nm,
+            fwhm_nm,
+        };
+        let e = plate_lobes(&q, &s, wi, Transport::Radiance).unwrap_err();
+        assert!(
+            ["wavelength_nm", "filter_bandwidth"].contains(&e.parameter.as_str()),
+            "{e}"
+        );
+    }
+}

@@ -16,6 +16,13 @@
 //! vary slowly). Orders beyond `N` are the
 //! incoherent closed-form tail of [`crate::paths`]. Pairs whose group path difference is far
 //! beyond the coherence length `1/σ` are skipped (their factor is below `e^{-18}`).
+//!
+//! [`Method::Auto`] first takes the closed forms that need no choice of order: a lossless
+//! isotropic plate is two Airy etalons ([`crate::etalon`], exact for Gaussians), and a narrow
+//! Gaussian (σ ≤ [`NARROW_BAND`] μ) through any plate is the matrix etalon of
+//! [`crate::spectral::narrow`] where its residual phases are resolved by a few nodes. The
+//! shared quadrature of [`integrate_set`] interpolates a dispersive plate's interface blocks
+//! across the band ([`crate::spectral::interpolate`]).
 
 use crate::cmath;
 use crate::error::{Error, Result};
@@ -70,7 +77,7 @@ pub enum Output {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Method {
     /// Chosen per Gaussian from the plate's round-trip path difference `D`, the number of
-    /// significant round trips and the coherence length `1/σ` (see [`auto`]): Gauss–Hermite
+    /// significant round trips and the coherence length `1/σ` (see `auto`): Gauss–Hermite
     /// quadrature of the exact plate when the integrand oscillates slowly over the band, the
     /// closed-form path-class sum otherwise.
     Auto,
@@ -219,8 +226,9 @@ fn etalon_band(
     etalon_sum(&etalon, band, want, output, &mut None)
 }
 
-/// `Σ_j a_j` × the etalon over Gaussian `j` (`None` if a series is too long). Thick plates give every Gaussian the same
-/// incoherent sum: it is evaluated once (and kept in `incoherent` for further bands).
+/// `Σ_j a_j` × the etalon over Gaussian `j` (`None` if a series is too long). Thick plates
+/// give every Gaussian the same incoherent sum: it is evaluated once (and kept in `incoherent`
+/// for further bands).
 pub fn etalon_sum(
     etalon: &Etalon,
     band: &[Gaussian],
