@@ -70,3 +70,48 @@ fn isotropic_crystal_weights_are_mitsubas_dielectric_weights() {
         "no radiance scaling in Importance"
     );
 }
+
+/// BFR_INTENSITY_ONLY's contract (cpp/include/birefringent.h): only M00 is computed, every other
+/// Mueller entry is zero, and M00 equals the full query's; exact and band-filtered, isotropic
+/// and birefringent plates (the fuzzer found the exact birefringent plate returning all 16).
+#[test]
+fn intensity_only_plate_queries_return_m00_alone() {
+    use birefringent::material::Material;
+    use birefringent::sampling::{plate_lobes, PlateQuery, Spectrum};
+    let mut rng = Rng::new(33);
+    for i in 0..200 {
+        let material = if i % 2 == 0 {
+            Material::constant(C64::new(1.5, 0.0), C64::new(1.5, 0.0)).unwrap()
+        } else {
+            Material::named("quartz", 0.0, 0.0).unwrap()
+        };
+        let query = |intensity| {
+            PlateQuery::new(
+                material,
+                0.0,
+                C64::new(1.0, 0.0),
+                C64::new(1.2, 0.0),
+                Vector3::new(1.0, 0.5, 0.3),
+                20_000.0,
+                true,
+                true,
+                intensity,
+            )
+            .unwrap()
+        };
+        let fwhm_nm = if i % 4 < 2 { 0.0 } else { 4.0 };
+        let s = Spectrum::Band { wavelength_nm: rng.range(400.0, 700.0), fwhm_nm };
+        let wi = rng.unit_vector();
+        if wi.z.abs() < 0.05 {
+            continue;
+        }
+        let m00 = plate_lobes(&query(true), &s, wi, Transport::Radiance).unwrap();
+        let full = plate_lobes(&query(false), &s, wi, Transport::Radiance).unwrap();
+        for (a, b) in m00[0].iter().zip(&full[0]) {
+            let (Some(a), Some(b)) = (a, b) else { continue };
+            assert!((a.mueller[(0, 0)] - b.mueller[(0, 0)]).abs() < 1e-12);
+            let rest: f64 = a.mueller.iter().skip(1).map(|x| x.abs()).sum();
+            assert_eq!(rest, 0.0, "intensity-only query returned {}", a.mueller);
+        }
+    }
+}

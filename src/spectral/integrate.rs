@@ -73,6 +73,20 @@ pub enum Output {
     Intensity,
 }
 
+impl Output {
+    /// `m` as this output asks: unchanged, or only `M00` (the other entries zero).
+    pub fn keep(self, m: SlabMueller) -> SlabMueller {
+        let cut = |m: Matrix4<f64>| match self {
+            Output::Mueller => m,
+            Output::Intensity => Matrix4::from_fn(|i, j| if i + j == 0 { m[(0, 0)] } else { 0.0 }),
+        };
+        SlabMueller {
+            r: m.r.map(cut),
+            t: m.t.map(cut),
+        }
+    }
+}
+
 /// How the Gaussians of a band are integrated.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Method {
@@ -203,14 +217,10 @@ pub fn integrate_with(
         r += mr * g.amplitude;
         t += mt * g.amplitude;
     }
-    let keep = |m: Matrix4<f64>| match output {
-        Output::Mueller => m,
-        Output::Intensity => Matrix4::from_fn(|i, j| if i + j == 0 { m[(0, 0)] } else { 0.0 }),
-    };
-    Ok(SlabMueller {
-        r: want.reflection.then(|| keep(r)),
-        t: want.transmission.then(|| keep(t)),
-    })
+    Ok(output.keep(SlabMueller {
+        r: want.reflection.then_some(r),
+        t: want.transmission.then_some(t),
+    }))
 }
 
 /// The isotropic fast path over a band ([`Etalon::band`], exact for Gaussians), where it
@@ -478,13 +488,11 @@ pub fn integrate_set(
             acc[c].1 += m.t.unwrap_or_default() * wc;
         }
     }
-    let keep = |m: Matrix4<f64>| match output {
-        Output::Mueller => m,
-        Output::Intensity => Matrix4::from_fn(|i, j| if i + j == 0 { m[(0, 0)] } else { 0.0 }),
-    };
-    Ok(acc.map(|(r, t)| SlabMueller {
-        r: want.reflection.then(|| keep(r)),
-        t: want.transmission.then(|| keep(t)),
+    Ok(acc.map(|(r, t)| {
+        output.keep(SlabMueller {
+            r: want.reflection.then_some(r),
+            t: want.transmission.then_some(t),
+        })
     }))
 }
 

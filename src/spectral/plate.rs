@@ -60,9 +60,8 @@ impl Plate {
         Etalon::new(self.ext, eo, self.exit, beta, self.thickness_nm)
     }
 
-    /// The exact Mueller matrices at `lambda_nm` (s/p frames of `frame`): the isotropic fast
-    /// path where it applies, else the general slab ([`Slab::optics`], full Mueller matrices
-    /// whatever `output` asks).
+    /// The exact Mueller matrices at `lambda_nm` (s/p frames of `frame`), as `output` asks: the
+    /// isotropic fast path where it applies, else the general slab ([`Slab::optics`]).
     pub fn mueller_at(
         &self,
         lambda_nm: f64,
@@ -73,10 +72,11 @@ impl Plate {
     ) -> Result<SlabMueller> {
         match self.etalon(lambda_nm, beta) {
             Some(e) => Ok(e.mueller(lambda_nm, want, output)),
-            None => self
-                .at(lambda_nm)?
-                .optics(frame, beta)?
-                .mueller(lambda_nm, want),
+            None => Ok(output.keep(
+                self.at(lambda_nm)?
+                    .optics(frame, beta)?
+                    .mueller(lambda_nm, want)?,
+            )),
         }
     }
 }
