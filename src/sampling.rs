@@ -404,7 +404,10 @@ fn lobes_of_plate(
         for (c, m) in ms.iter().enumerate() {
             let m = if component == 0 { m.r } else { m.t };
             let Some(m) = m else { continue };
-            let mueller = m * scale;
+            let mut mueller = m * scale;
+            // A band-averaged coherency of a plate that passes (almost) nothing can give M00 a
+            // rounding-level negative (seen: -2e-22); the unpolarised throughput is >= 0.
+            mueller[(0, 0)] = mueller[(0, 0)].max(0.0);
             out[c][component] = Some(PathLobe {
                 component,
                 wo,
