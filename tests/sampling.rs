@@ -100,7 +100,10 @@ fn intensity_only_plate_queries_return_m00_alone() {
             .unwrap()
         };
         let fwhm_nm = if i % 4 < 2 { 0.0 } else { 4.0 };
-        let s = Spectrum::Band { wavelength_nm: rng.range(400.0, 700.0), fwhm_nm };
+        let s = Spectrum::Band {
+            wavelength_nm: rng.range(400.0, 700.0),
+            fwhm_nm,
+        };
         let wi = rng.unit_vector();
         if wi.z.abs() < 0.05 {
             continue;
