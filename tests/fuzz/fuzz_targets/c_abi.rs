@@ -450,7 +450,9 @@ fuzz_target!(|data: &[u8]| {
             } else {
                 waves.as_ptr()
             };
-            let a = args(format!("wavelengths {waves:?} (count {count}), fwhm {fwhm}"));
+            let a = args(format!(
+                "wavelengths {waves:?} (count {count}), fwhm {fwhm}"
+            ));
             call(
                 &mut b,
                 &a,
