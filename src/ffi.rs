@@ -30,6 +30,8 @@ pub const BFR_WANT_REFLECTION: i32 = 1;
 pub const BFR_WANT_TRANSMISSION: i32 = 2;
 /// Plate flag: intensity only.
 pub const BFR_INTENSITY_ONLY: i32 = 4;
+/// Plate flag: the exit medium absorbs what enters it (no transmission, no light from below).
+pub const BFR_ABSORBING_EXIT: i32 = 8;
 /// Mitsuba's `TransportMode::Radiance`.
 pub const BFR_RADIANCE: i32 = 0;
 /// Mitsuba's `TransportMode::Importance`.
@@ -309,10 +311,12 @@ pub unsafe extern "C" fn bfr_crystal_lobes(
 }
 
 fn plate_query(m: &Material, g: &BfrGeometry, flags: i32) -> Result<PlateQuery> {
-    if flags & !(BFR_WANT_REFLECTION | BFR_WANT_TRANSMISSION | BFR_INTENSITY_ONLY) != 0 {
+    let known =
+        BFR_WANT_REFLECTION | BFR_WANT_TRANSMISSION | BFR_INTENSITY_ONLY | BFR_ABSORBING_EXIT;
+    if flags & !known != 0 {
         return Err(Error::new("flags", format!("unknown bits in {flags}")));
     }
-    PlateQuery::new(
+    Ok(PlateQuery::new(
         *m,
         g.birefringence,
         C64::new(g.ext_ior, 0.0),
@@ -322,7 +326,8 @@ fn plate_query(m: &Material, g: &BfrGeometry, flags: i32) -> Result<PlateQuery> 
         flags & BFR_WANT_REFLECTION != 0,
         flags & BFR_WANT_TRANSMISSION != 0,
         flags & BFR_INTENSITY_ONLY != 0,
-    )
+    )?
+    .with_absorbing_exit(flags & BFR_ABSORBING_EXIT != 0))
 }
 
 /// The shared body of the plate entry points: validates the pointers, evaluates the plate over

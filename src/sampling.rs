@@ -207,6 +207,9 @@ pub struct PlateQuery {
     pub want: Want,
     /// Only `M00`.
     pub output: Output,
+    /// The exit medium absorbs whatever enters it (a film on a black substrate): no
+    /// transmission lobe, and no light from below (it cannot reach the plate).
+    pub absorbing_exit: bool,
 }
 
 /// Over which spectrum a plate query is evaluated.
@@ -314,7 +317,16 @@ impl PlateQuery {
             } else {
                 Output::Mueller
             },
+            absorbing_exit: false,
         })
+    }
+
+    /// The same query with an absorbing exit medium or not ([`PlateQuery::absorbing_exit`]).
+    pub fn with_absorbing_exit(self, absorbing_exit: bool) -> Self {
+        PlateQuery {
+            absorbing_exit,
+            ..self
+        }
     }
 
     /// The same plate seen from below: exterior and exit swapped, mirrored through `z = 0`.
@@ -362,9 +374,12 @@ fn lobes_of_plate(
     }
     let channels = spectrum.channels()?;
     let mut out = vec![[None, None]; channels];
-    if wi.z == 0.0 {
+    if wi.z == 0.0 || (q.absorbing_exit && wi.z < 0.0) {
         return Ok(out);
     }
+    let mut q = *q;
+    q.want.transmission &= !q.absorbing_exit;
+    let q = &q;
     let wi = wi.normalize();
     let reflected = Vector3::new(-wi.x, -wi.y, wi.z);
     let through = through_plate(q, wi);

@@ -120,7 +120,7 @@ fn c_program_agrees_with_the_rust_api() {
         at += 7;
     }
     assert_eq!(lines[at], "plate 0");
-    let q = PlateQuery::new(
+    let both = PlateQuery::new(
         calcite,
         0.0,
         C64::new(1.0, 0.0),
@@ -136,7 +136,7 @@ fn c_program_agrees_with_the_rust_api() {
         wavelength_nm: 550.0,
         fwhm_nm: 0.0,
     };
-    let p = plate_lobes(&q, &band, wi, Transport::Radiance).unwrap();
+    let p = plate_lobes(&both, &band, wi, Transport::Radiance).unwrap();
     expect_lobe(lines[at + 1], p[0][0].as_ref());
     expect_lobe(lines[at + 2], p[0][1].as_ref());
     let q = PlateQuery::new(
@@ -171,24 +171,12 @@ fn c_program_agrees_with_the_rust_api() {
     );
     // Three wavelengths in one query equal three single queries (band-filtered, 4 nm).
     assert_eq!(lines[at + 4], "bands 0");
-    let q = PlateQuery::new(
-        calcite,
-        0.0,
-        C64::new(1.0, 0.0),
-        C64::new(1.0, 0.0),
-        axis,
-        2500.0,
-        true,
-        true,
-        false,
-    )
-    .unwrap();
     for (i, wavelength_nm) in [450.0, 550.0, 650.0].into_iter().enumerate() {
         let band = Spectrum::Band {
             wavelength_nm,
             fwhm_nm: 4.0,
         };
-        let p = plate_lobes(&q, &band, wi, Transport::Radiance).unwrap();
+        let p = plate_lobes(&both, &band, wi, Transport::Radiance).unwrap();
         expect_lobe(lines[at + 5 + 2 * i], p[0][0].as_ref());
         expect_lobe(lines[at + 6 + 2 * i], p[0][1].as_ref());
     }

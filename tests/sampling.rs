@@ -118,3 +118,49 @@ fn intensity_only_plate_queries_return_m00_alone() {
         }
     }
 }
+
+/// An absorbing exit medium: the reflection lobe of the plain plate alone from above, nothing
+/// from below.
+#[test]
+fn absorbing_exit_keeps_the_front_reflection_only() {
+    use birefringent::material::Material;
+    use birefringent::sampling::{plate_lobes, PlateQuery, Spectrum};
+    let mut rng = Rng::new(34);
+    let q = PlateQuery::new(
+        Material::named("quartz", 0.0, 0.0).unwrap(),
+        0.0,
+        C64::new(1.0, 0.0),
+        C64::new(1.458, 0.0),
+        Vector3::new(1.0, 1.0, 0.0),
+        700.0,
+        true,
+        true,
+        false,
+    )
+    .unwrap();
+    let black = q.with_absorbing_exit(true);
+    for _ in 0..200 {
+        let wi = rng.unit_vector();
+        let s = Spectrum::Band {
+            wavelength_nm: rng.range(400.0, 700.0),
+            fwhm_nm: 4.0,
+        };
+        for t in [Transport::Radiance, Transport::Importance] {
+            let (a, b) = (
+                plate_lobes(&black, &s, wi, t).unwrap(),
+                plate_lobes(&q, &s, wi, t).unwrap(),
+            );
+            assert!(a[0][1].is_none(), "a transmission lobe");
+            if wi.z < 0.0 {
+                assert!(
+                    a[0][0].is_none(),
+                    "light from inside the absorbing exit medium"
+                );
+            } else if let (Some(x), Some(y)) = (a[0][0], b[0][0]) {
+                assert_eq!(x.mueller, y.mueller);
+            } else {
+                panic!("reflection lobe missing for {wi:?}");
+            }
+        }
+    }
+}

@@ -29,6 +29,8 @@ extern "C" {
 #define BFR_WANT_REFLECTION 1
 #define BFR_WANT_TRANSMISSION 2
 #define BFR_INTENSITY_ONLY 4 /* only mueller[0] (M00) is computed; the rest is zero */
+#define BFR_ABSORBING_EXIT 8 /* the exit medium absorbs what enters it: no transmission lobe,
+                                no light from below (a film on a black substrate) */
 
 typedef struct bfr_complex {
     double re, im;

@@ -96,10 +96,7 @@ public:
                                              Mask active) const override {
         MI_MASKED_FUNCTION(ProfilerPhase::BSDFSample, active);
         int32_t want = (ctx.is_enabled(m_types[0], 0) ? BFR_WANT_REFLECTION : 0) |
-                       (ctx.is_enabled(m_types[1], 1) && !m_absorbing_exit ? BFR_WANT_TRANSMISSION : 0);
-        // An absorbing exit medium: light never arrives from below.
-        if (m_absorbing_exit && !(Frame3f::cos_theta(si.wi) > 0.f))
-            want = 0;
+                       (ctx.is_enabled(m_types[1], 1) ? BFR_WANT_TRANSMISSION : 0);
         bfr_path_lobe lobes[Lobes::Channels * 2];
         if (!active || !want || !query(si, ctx.mode, want, lobes))
             return { dr::zeros<BSDFSample3f>(), dr::zeros<Spectrum>() };
@@ -173,7 +170,8 @@ private:
                                   m_axis_angle ? (double) m_axis_angle->eval_1(si) : 0.0);
         const double wi[3] = { si.wi.x(), si.wi.y(), si.wi.z() };
         int32_t transport = mode == TransportMode::Radiance ? BFR_RADIANCE : BFR_IMPORTANCE;
-        int32_t flags = want | (is_polarized_v<Spectrum> ? 0 : BFR_INTENSITY_ONLY);
+        int32_t flags = want | (is_polarized_v<Spectrum> ? 0 : BFR_INTENSITY_ONLY) |
+                        (m_absorbing_exit ? BFR_ABSORBING_EXIT : 0);
         char message[bfr::MessageLen] = { 0 };
         int32_t rc = BFR_OK;
         if constexpr (is_rgb_v<Spectrum>) {

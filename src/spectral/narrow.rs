@@ -92,7 +92,13 @@ pub fn band(
             let z = C64::new(g.sigma * x, g.sigma * g.sigma * plate.fast(delta));
             let m = plate.at(z)?;
             // (I ⊗ D^Δ)(t̄₁ ⊗ t₁) = t̄₁ ⊗ D^Δ t₁.
-            let rhs = kron(&t1_bar, &(power(&m.d, delta) * plate.t1));
+            let before = power(&m.d, delta.saturating_sub(1)); // D^(Δ−1), also for R below
+            let dt1 = if delta == 0 {
+                plate.t1
+            } else {
+                m.d * before * plate.t1
+            };
+            let rhs = kron(&t1_bar, &dt1);
             let y = cmath::solve4(&(Matrix4::identity() - kron(&m.d_bar, &m.d)), &rhs)?;
             let weight = C64::new(w * gd, 0.0);
             let (target_t, target_r) = if delta == 0 {
@@ -107,7 +113,7 @@ pub fn band(
                 *target_r += kron(&m.v_bar, &m.v) * y * weight;
                 if delta >= 1 {
                     // r₁ (no round trip) with order `delta`: conj(r₁) ⊗ V D^(Δ−1) t₁.
-                    let u = m.v * power(&m.d, delta - 1) * plate.t1;
+                    let u = m.v * before * plate.t1;
                     mirrored_r += kron(&plate.r1.map(|z| z.conj()), &u) * weight;
                 }
             }

@@ -355,7 +355,7 @@ fuzz_target!(|data: &[u8]| {
     };
     let flags = match b.u8() % 4 {
         0 => b.i32(),
-        _ => (b.u8() % 8) as i32,
+        _ => (b.u8() % 16) as i32,
     };
     let importance = transport == BFR_IMPORTANCE;
     let name = if d.material.is_null() {
