@@ -10,7 +10,8 @@
 //! (air → calcite-like crystal, 4x4 solve), `crystal_iso` / `crystal_calcite` (bulk surface
 //! lobes, Radiance), `plate_*` (`plate_lobes`, Radiance, both lobes: isotropic 1 mm plate
 //! exact / 4 nm band / sRGB, quartz 20 um, 60 um, calcite 1 mm and a 3 mm photoelastic-like
-//! plate in a 4 nm band, a 0.5 um lithium niobate film in sRGB). Directions: 64 on a spiral up
+//! plate in a 4 nm band, a 0.5 um lithium niobate film in sRGB: in air, and as in the thin_film
+//! scene, x-cut on black silica, `plate_film_scene_rgb`). Directions: 64 on a spiral up
 //! to `THETA_MAX` degrees from the normal (default 80).
 
 use birefringent::interface::Interface;
@@ -139,7 +140,7 @@ fn main() {
                         fwhm_nm: 4.0,
                     },
                 ),
-                "plate_film_rgb" => (
+                "plate_film_scene_rgb" | "plate_film_rgb" => (
                     Material::named("linbo3", 0.0, 0.0).unwrap(),
                     500.0,
                     Spectrum::Weights(WeightSet::SrgbD65),
@@ -147,18 +148,16 @@ fn main() {
                 _ => panic!("unknown case"),
             };
             let intensity = case.ends_with("rgb");
-            let q = PlateQuery::new(
-                mat,
-                0.0,
-                c(1.0),
-                c(1.0),
-                Vector3::new(1.0, 1.0, 0.0),
-                th,
-                true,
-                true,
-                intensity,
-            )
-            .unwrap();
+            // The thin_film scene's query: x-cut film on black silica (reflection only).
+            let scene = case == "plate_film_scene_rgb";
+            let (exit, axis) = if scene {
+                (1.458, Vector3::new(1.0, 0.0, 0.0))
+            } else {
+                (1.0, Vector3::new(1.0, 1.0, 0.0))
+            };
+            let q = PlateQuery::new(mat, 0.0, c(1.0), c(exit), axis, th, true, true, intensity)
+                .unwrap()
+                .with_absorbing_exit(scene);
             for i in 0..n {
                 black_box(plate_lobes(&q, &spec, ds[i % 64], Transport::Radiance).unwrap());
             }

@@ -22,7 +22,8 @@
 //! Gaussian (σ ≤ [`NARROW_BAND`] μ) through any plate is the matrix etalon of
 //! [`crate::spectral::narrow`] where its residual phases are resolved by a few nodes. The
 //! shared quadrature of [`integrate_set`] interpolates a dispersive plate's interface blocks
-//! across the band ([`crate::spectral::interpolate`]).
+//! across the band ([`crate::spectral::interpolate`]) and sizes its panels order by order
+//! ([`crate::spectral::shared`]).
 
 use crate::cmath;
 use crate::error::{Error, Result};
@@ -30,11 +31,11 @@ use crate::etalon::Etalon;
 use crate::frame::PlaneFrame;
 use crate::mueller;
 use crate::paths::{PathClass, PathExpansion};
-use crate::slab::{SlabBlocks, SlabMueller, SlabOptics, Want};
+use crate::slab::{SlabMueller, SlabOptics, Want};
 use crate::spectral::hermite;
-use crate::spectral::interpolate::BlockInterpolant;
 use crate::spectral::narrow;
 use crate::spectral::plate::Plate;
+use crate::spectral::shared;
 use crate::spectral::weights::{gaussians, Gaussian, WeightSet};
 use nalgebra::{Matrix2, Matrix4};
 use num_complex::Complex64 as C64;
@@ -316,12 +317,20 @@ fn traversals(optics: &SlabOptics, disp: &Dispersion, mu: f64) -> [narrow::Trave
 
 /// The smallest and largest group path per unit thickness of one internal round trip,
 /// `d(k Re(q↑ − q↓))/dk` over the mode pairs (the phase index without dispersion).
-fn group_round_trips(optics: &SlabOptics, disp: &Dispersion, mu: f64) -> (f64, f64) {
+pub(crate) fn group_round_trips(optics: &SlabOptics, disp: &Dispersion, mu: f64) -> (f64, f64) {
     let m = optics.layer_modes();
     let trips = (0..2).flat_map(|a| {
         (0..2).map(move |b| (m.up[a].q - m.down[b].q).re + mu * (disp.d1[2 + a] + disp.d1[b]))
     });
     trips.fold((f64::INFINITY, 0.0), |(lo, hi), t| (lo.min(t), hi.max(t)))
+}
+
+/// The largest difference of group path per unit thickness between the two modes travelling
+/// the same way, `d(k Re(q_o − q_e))/dk` (the direct paths' birefringent oscillation).
+pub(crate) fn group_splitting(optics: &SlabOptics, disp: &Dispersion, mu: f64) -> f64 {
+    let q = optics.layer_q();
+    let g = |j: usize| q[j].re + mu * disp.d1[j] * if j < 2 { -1.0 } else { 1.0 };
+    (g(0) - g(1)).abs().max((g(2) - g(3)).abs())
 }
 
 /// [`Method::Auto`]'s choice for one Gaussian. With `a = σ D` per round trip and `N` the
@@ -402,17 +411,13 @@ fn quadrature_rule(
     Ok((r, t))
 }
 
-/// Largest number of plate evaluations [`integrate_set`] spends on one shared quadrature.
-pub const SHARED_NODES_MAX: usize = 1024;
-
 /// Integrates over the three channels of a weight set at once (see [`integrate`]).
 ///
-/// When the plate's spectrum varies slowly over the whole visible range (thin plates: few
-/// oscillations of its longest significant path difference across the weights' support), one
-/// composite Gauss–Legendre quadrature of the exact plate over that support serves every
-/// Gaussian of every channel: `∫ w_c(k) M(k) dk` with `w_c` the same fitted sum of Gaussians, at
-/// most [`SHARED_NODES_MAX`] plate evaluations instead of a quadrature per Gaussian. Otherwise
-/// each channel goes through [`integrate`].
+/// A lossless isotropic plate takes its closed form per Gaussian. Otherwise, when the plate's
+/// spectrum varies slowly over the whole visible range (thin plates: few oscillations of its
+/// significant orders across the weights' support), one composite quadrature of the exact plate
+/// serves every Gaussian of every channel ([`shared`]: at most 1024 plate evaluations instead
+/// of a quadrature per Gaussian). Otherwise each channel goes through [`integrate`].
 pub fn integrate_set(
     plate: &Plate,
     frame: &PlaneFrame,
@@ -430,82 +435,24 @@ pub fn integrate_set(
             return Ok([a, b, c]);
         }
     }
-    let all = bands.iter().flat_map(|b| b.iter());
-    let lo = all
-        .clone()
-        .map(|g| g.mu - 6.0 * g.sigma)
-        .fold(f64::INFINITY, f64::min)
-        .max(1e-6);
-    let hi = all.map(|g| g.mu + 6.0 * g.sigma).fold(0.0, f64::max);
-    let centre = std::f64::consts::TAU / (0.5 * (lo + hi));
-    let optics = plate.at(centre)?.optics(frame, beta)?;
-    let orders = amplitude_order(&optics, centre, MAX_PANEL_ORDER) as f64 + 1.0;
-    // The fastest oscillation: the largest group round trip, at the centre and at the short
-    // wavelength end (where dispersion is steepest).
-    let mut rt = 0.0f64;
-    for k in [0.5 * (lo + hi), hi] {
-        let o = plate.at(std::f64::consts::TAU / k)?.optics(frame, beta)?;
-        rt = rt.max(group_round_trips(&o, &dispersion(plate, frame, beta, k)?, k).1);
-    }
-    let oscillations = optics.thickness_nm * rt * orders * (hi - lo) / std::f64::consts::TAU;
-    // Two thirds of an oscillation of the fastest significant order per 8-point Gauss–Legendre
-    // panel: the rule integrates exp(i ω x) over that span to ~1e-12 (and over one period to
-    // 9e-11; the estimate of the fastest order can be low by a few tens of per cent).
-    // (Compared in floating point first: a huge plate must not overflow the node count.)
-    if oscillations.is_nan() || 12.0 * oscillations > SHARED_NODES_MAX as f64 {
-        let one = |c: usize| integrate(plate, frame, beta, bands[c], want, output);
-        return Ok([one(0)?, one(1)?, one(2)?]);
-    }
-    let panels = ((1.5 * oscillations).ceil() as usize).max(8);
-    // The blocks at each node: fixed without dispersion; else interpolated across the band
-    // (checked; exact at every node where the interpolant is refused).
-    let exact = |k: f64| -> Result<SlabBlocks> {
-        Ok(plate
-            .at(std::f64::consts::TAU / k)?
-            .optics(frame, beta)?
-            .blocks())
-    };
-    let fixed = (!plate.is_dispersive()).then(|| optics.blocks());
-    let interpolant = match fixed {
-        Some(_) => None,
-        None => BlockInterpolant::new(lo, hi, optics.thickness_nm, &exact)?,
-    };
-    let mut acc = [(Matrix4::zeros(), Matrix4::zeros()); 3];
-    for (k, w) in hermite::composite_interval(lo, hi, panels) {
-        let lambda = std::f64::consts::TAU / k;
-        let blocks = match (fixed, &interpolant) {
-            (Some(b), _) => b,
-            (None, Some(f)) => f.at(k),
-            (None, None) => exact(k)?,
-        };
-        let m = blocks.mueller(lambda, want)?;
-        for (c, band) in bands.iter().enumerate() {
-            let wc = w * band
-                .iter()
-                .map(|g| g.amplitude * normal_pdf(k, g))
-                .sum::<f64>();
-            acc[c].0 += m.r.unwrap_or_default() * wc;
-            acc[c].1 += m.t.unwrap_or_default() * wc;
+    match shared::plan(plate, frame, beta, set)? {
+        Some(panels) => shared::quadrature(plate, frame, beta, set, panels, want, output),
+        None => {
+            let one = |c: usize| integrate(plate, frame, beta, bands[c], want, output);
+            Ok([one(0)?, one(1)?, one(2)?])
         }
     }
-    Ok(acc.map(|(r, t)| {
-        output.keep(SlabMueller {
-            r: want.reflection.then_some(r),
-            t: want.transmission.then_some(t),
-        })
-    }))
-}
-
-/// The unit-mass normal density `G(k; μ, σ)`.
-fn normal_pdf(k: f64, g: &Gaussian) -> f64 {
-    let z = (k - g.mu) / g.sigma;
-    (-0.5 * z * z).exp() / (g.sigma * std::f64::consts::TAU.sqrt())
 }
 
 /// First and second derivatives in `k` of the phase-per-traversal `Q` of the layer's four modes
 /// `[o↓, e↓, o↑, e↑]` at wavenumber `mu` (zero without dispersion), by central differences of
 /// the exact modes (step `10⁻³ μ`: truncation ~10⁻⁶, rounding ~10⁻¹⁰ relative).
-fn dispersion(plate: &Plate, frame: &PlaneFrame, beta: C64, mu: f64) -> Result<Dispersion> {
+pub(crate) fn dispersion(
+    plate: &Plate,
+    frame: &PlaneFrame,
+    beta: C64,
+    mu: f64,
+) -> Result<Dispersion> {
     if !plate.is_dispersive() {
         return Ok(Dispersion::default());
     }
@@ -523,7 +470,7 @@ fn dispersion(plate: &Plate, frame: &PlaneFrame, beta: C64, mu: f64) -> Result<D
 
 /// `dQ/dk` and `d²Q/dk²` per mode (see [`dispersion`]).
 #[derive(Clone, Copy, Debug, Default)]
-struct Dispersion {
+pub(crate) struct Dispersion {
     d1: [f64; 4],
     d2: [f64; 4],
 }

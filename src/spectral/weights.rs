@@ -63,7 +63,7 @@ impl WeightSet {
         }
     }
 
-    fn index(self) -> usize {
+    pub(crate) fn index(self) -> usize {
         match self {
             WeightSet::XyzE => 0,
             WeightSet::XyzD65 => 1,

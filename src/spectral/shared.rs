@@ -1,0 +1,318 @@
+//! One quadrature of the exact plate shared by the three channels of a weight set, for plates
+//! whose spectrum varies slowly over the visible range (thin plates and films).
+//!
+//! `∫ w_c(k) M(k) dk` for the channels `c` of a fitted weight set ([`gaussians`]) by composite
+//! 8-point Gauss–Legendre over the weights' support `[lo, hi]` (every Gaussian's `μ ± 6σ`):
+//! each node solves the plate once (its interface blocks interpolated across the band,
+//! [`BlockInterpolant`]) and serves all three channels.
+//!
+//! **How many panels.** The plate's spectrum is a sum of oscillations `A(k) e^{iωk}`: the
+//! direct paths' birefringent phase difference (amplitude up to 1, `ω ≤ ω_b`, the largest
+//! difference of the modes' group paths), and per order `n` of internal round trips an
+//! amplitude of at most `a_n = ρⁿ / (1 − ρ)²` relative to the direct light (`ρ` the norm of the
+//! round-trip matrix; the factor sums the pairs of paths whose orders differ by `n`) at
+//! `ω ≤ n ω₁ + ω_b` (`ω₁` the largest group round trip). The error of a rule on one oscillation
+//! is known exactly: `|Σ_i w_c(k_i) e^{iωk_i} − Σ_j a_j e^{iωμ_j − σ_j²ω²/2}|` (the fitted
+//! weights' Fourier transform is a sum of Gaussians), tabulated per rule over `ω`. The rule
+//! used is the smallest of [`LADDER`] whose error, times each oscillation's amplitude, stays
+//! below [`TOLERANCE`] for every channel (frequencies × [`SPAN_MARGIN`]): low orders, which
+//! carry the light, are resolved to many digits, high orders only as far as their weight needs,
+//! and the fitted weights' own shape is resolved too.
+//!
+//! **The nodes and their weights** depend only on the weight set and the panel count: they are
+//! computed once per (set, rung of the ladder) and kept, with the rule's error table.
+
+use crate::error::Result;
+use crate::frame::PlaneFrame;
+use crate::slab::{SlabBlocks, SlabMueller, Want};
+use crate::spectral::hermite;
+use crate::spectral::integrate::{dispersion, group_round_trips, group_splitting, Output};
+use crate::spectral::interpolate::BlockInterpolant;
+use crate::spectral::plate::Plate;
+use crate::spectral::weights::{gaussians, Gaussian, WeightSet};
+use nalgebra::Matrix4;
+use num_complex::Complex64 as C64;
+use std::f64::consts::TAU;
+use std::sync::OnceLock;
+
+/// Largest error (absolute, in units of the light carried by the direct paths) a panel may make
+/// on any order of round trips: far below anything visible (a CIEDE2000 of 1 is ~1e-2 of the
+/// signal) and below the fitted weights' own error.
+pub const TOLERANCE: f64 = 1e-7;
+
+/// Margin on the estimated phase span `Φ` (the group round trip is evaluated at the support's
+/// centre and short end; elsewhere it can be larger by a few per cent).
+pub const SPAN_MARGIN: f64 = 1.3;
+
+/// Panel counts the rule is rounded up to (at most 128 panels: 1024 plate evaluations).
+pub const LADDER: [usize; 17] = [
+    8, 10, 12, 14, 16, 20, 24, 28, 32, 40, 48, 56, 64, 80, 96, 112, 128,
+];
+
+/// The nodes `k` of the composite rule on the weights' support with `panels` panels, each with
+/// its quadrature weight times every channel's fitted weight at `k`.
+pub struct Rule {
+    /// `(k, [w Σ_j a_j G_j(k) per channel])`.
+    pub nodes: Vec<(f64, [f64; 3])>,
+    /// The support `[lo, hi]` (wavenumbers, 1/nm).
+    pub lo: f64,
+    /// See `lo`.
+    pub hi: f64,
+    /// `error[i]`: the largest error of the rule on `e^{iωk}` over the channels and over
+    /// `ω ≤ i × step` (module docs).
+    error: Vec<f64>,
+    /// Frequency step of `error` (nm).
+    step: f64,
+}
+
+/// Frequencies tabulated per rule, up to a phase of [`PHASE_PER_PANEL`] per panel.
+const FREQUENCIES: usize = 512;
+/// Beyond this phase per panel an 8-point panel's error exceeds 0.1: no rule is accurate there.
+const PHASE_PER_PANEL: f64 = 28.0;
+
+impl Rule {
+    /// The rule's largest error on any oscillation `e^{iω'k}` with `ω' ≤ omega` (1 beyond
+    /// its table).
+    pub fn error_at(&self, omega: f64) -> f64 {
+        let i = (omega / self.step).ceil();
+        if i.is_nan() || i >= self.error.len() as f64 {
+            1.0
+        } else {
+            self.error[i.max(0.0) as usize]
+        }
+    }
+
+    /// The error table (see [`Rule::error_at`]).
+    fn tabulate(set: WeightSet, nodes: &[(f64, [f64; 3])], step: f64) -> Vec<f64> {
+        let i = C64::new(0.0, 1.0);
+        let mut sums = vec![[C64::new(0.0, 0.0); 3]; FREQUENCIES];
+        for &(k, w) in nodes {
+            // e^{iωk} for ω = 0, step, 2 step, ... by repeated multiplication.
+            let (turn, mut phasor) = ((i * step * k).exp(), C64::new(1.0, 0.0));
+            for s in sums.iter_mut() {
+                for (sc, wc) in s.iter_mut().zip(w) {
+                    *sc += phasor * wc;
+                }
+                phasor *= turn;
+            }
+        }
+        let mut worst = 0.0f64;
+        sums.iter()
+            .enumerate()
+            .map(|(j, s)| {
+                let omega = step * j as f64;
+                for (c, sc) in s.iter().enumerate() {
+                    let exact: C64 = gaussians(set, c)
+                        .iter()
+                        .map(|g| {
+                            g.amplitude * (i * omega * g.mu - 0.5 * (g.sigma * omega).powi(2)).exp()
+                        })
+                        .sum();
+                    worst = worst.max((sc - exact).norm());
+                }
+                worst
+            })
+            .collect()
+    }
+}
+
+/// The support `[lo, hi]` of a weight set: every Gaussian's `μ ± 6σ`.
+pub fn support(set: WeightSet) -> (f64, f64) {
+    let all = (0..3).flat_map(|c| gaussians(set, c).iter());
+    let lo = all
+        .clone()
+        .map(|g| g.mu - 6.0 * g.sigma)
+        .fold(f64::INFINITY, f64::min)
+        .max(1e-6);
+    let hi = all.map(|g| g.mu + 6.0 * g.sigma).fold(0.0, f64::max);
+    (lo, hi)
+}
+
+/// The rule for `set` with `panels` (a rung of [`LADDER`]), computed once.
+pub fn rule(set: WeightSet, panels: usize) -> &'static Rule {
+    const SETS: usize = WeightSet::ALL.len();
+    static RULES: [[OnceLock<Rule>; LADDER.len()]; SETS] =
+        [const { [const { OnceLock::new() }; LADDER.len()] }; SETS];
+    let rung = LADDER
+        .iter()
+        .position(|&r| r >= panels)
+        .unwrap_or(LADDER.len() - 1);
+    RULES[set.index()][rung].get_or_init(|| {
+        let (lo, hi) = support(set);
+        let nodes: Vec<(f64, [f64; 3])> = hermite::composite_interval(lo, hi, LADDER[rung])
+            .into_iter()
+            .map(|(k, w)| {
+                let channel = |c: usize| -> f64 {
+                    gaussians(set, c)
+                        .iter()
+                        .map(|g| g.amplitude * normal_pdf(k, g))
+                        .sum()
+                };
+                (k, [0, 1, 2].map(|c| w * channel(c)))
+            })
+            .collect();
+        let step = PHASE_PER_PANEL * LADDER[rung] as f64 / (hi - lo) / FREQUENCIES as f64;
+        let error = Rule::tabulate(set, &nodes, step);
+        Rule {
+            nodes,
+            lo,
+            hi,
+            error,
+            step,
+        }
+    })
+}
+
+/// The unit-mass normal density `G(k; μ, σ)`.
+fn normal_pdf(k: f64, g: &Gaussian) -> f64 {
+    let z = (k - g.mu) / g.sigma;
+    (-0.5 * z * z).exp() / (g.sigma * TAU.sqrt())
+}
+
+/// The panel count the shared quadrature needs for this plate and weight set (module docs), or
+/// `None` if the plate's spectrum oscillates too fast for one shared rule (then each Gaussian
+/// is integrated on its own).
+pub fn plan(plate: &Plate, frame: &PlaneFrame, beta: C64, set: WeightSet) -> Result<Option<usize>> {
+    let (lo, hi) = support(set);
+    // The round trip's norm, its fastest group path and the largest group path difference of
+    // the modes, at the centre and at the short end (where dispersion is steepest).
+    let (mut rho, mut trip, mut split) = (0.0f64, 0.0f64, 0.0f64);
+    for k in [0.5 * (lo + hi), hi] {
+        let optics = plate.at(TAU / k)?.optics(frame, beta)?;
+        let (pd, pu) = optics.propagation(TAU / k);
+        rho = rho.max((optics.top.r_below() * pu * optics.bottom.r_above() * pd).norm());
+        let disp = dispersion(plate, frame, beta, k)?;
+        trip = trip.max(group_round_trips(&optics, &disp, k).1);
+        split = split.max(group_splitting(&optics, &disp, k));
+    }
+    let d = plate.thickness_nm;
+    Ok(panels(set, d * trip, d * split, rho))
+}
+
+/// The smallest rung of [`LADDER`] whose rule integrates oscillations of amplitude 1 up to
+/// `omega_b` and of amplitude `a_n` up to `n omega_1 + omega_b` to [`TOLERANCE`] (module docs).
+pub fn panels(set: WeightSet, omega_1: f64, omega_b: f64, rho: f64) -> Option<usize> {
+    if !(omega_1.is_finite() && omega_b.is_finite() && (0.0..1.0).contains(&rho)) {
+        return None;
+    }
+    LADDER.iter().copied().find(|&p| {
+        let rule = rule(set, p);
+        let fits = |amplitude: f64, omega: f64| {
+            amplitude * rule.error_at(SPAN_MARGIN * omega) <= TOLERANCE
+        };
+        if !fits(1.0, omega_b) {
+            return false;
+        }
+        let mut a = 1.0 / ((1.0 - rho) * (1.0 - rho));
+        for n in 1.. {
+            a *= rho;
+            if a <= TOLERANCE {
+                return true;
+            }
+            if !fits(a, n as f64 * omega_1 + omega_b) {
+                return false;
+            }
+        }
+        unreachable!()
+    })
+}
+
+/// `∫ w_c(k) M(k) dk` for the three channels of `set` with the shared rule of `panels` panels
+/// (module docs).
+pub fn quadrature(
+    plate: &Plate,
+    frame: &PlaneFrame,
+    beta: C64,
+    set: WeightSet,
+    panels: usize,
+    want: Want,
+    output: Output,
+) -> Result<[SlabMueller; 3]> {
+    let rule = rule(set, panels);
+    // The blocks at each node: fixed without dispersion; else interpolated across the band
+    // (checked; exact at every node where the interpolant is refused).
+    let exact =
+        |k: f64| -> Result<SlabBlocks> { Ok(plate.at(TAU / k)?.optics(frame, beta)?.blocks()) };
+    let centre = 0.5 * (rule.lo + rule.hi);
+    let fixed = if plate.is_dispersive() {
+        None
+    } else {
+        Some(exact(centre)?)
+    };
+    let interpolant = match fixed {
+        Some(_) => None,
+        None => BlockInterpolant::new(rule.lo, rule.hi, plate.thickness_nm, &exact)?,
+    };
+    let mut acc = [[Matrix4::zeros(); 2]; 3];
+    for &(k, w) in &rule.nodes {
+        let blocks = match (fixed, &interpolant) {
+            (Some(b), _) => b,
+            (None, Some(f)) => f.at(k),
+            (None, None) => exact(k)?,
+        };
+        let m = blocks.mueller(TAU / k, want)?;
+        let lobes = [m.r, m.t];
+        for (sums, wc) in acc.iter_mut().zip(w) {
+            for (sum, lobe) in sums.iter_mut().zip(&lobes) {
+                match (lobe, output) {
+                    (Some(x), Output::Mueller) => *sum += x * wc,
+                    (Some(x), Output::Intensity) => sum[(0, 0)] += x[(0, 0)] * wc,
+                    (None, _) => {}
+                }
+            }
+        }
+    }
+    Ok(acc.map(|[r, t]| SlabMueller {
+        r: want.reflection.then_some(r),
+        t: want.transmission.then_some(t),
+    }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The tabulated error is the rule's: a direct evaluation at frequencies off the grid stays
+    /// below the table's value for them (the table is a running maximum over its grid).
+    #[test]
+    fn error_table_bounds_the_rule() {
+        for set in WeightSet::ALL {
+            let r = rule(set, 16);
+            for j in 0..50 {
+                let omega = r.step * (0.37 + 7.3 * j as f64);
+                for c in 0..3 {
+                    let sum: C64 = r
+                        .nodes
+                        .iter()
+                        .map(|&(k, w)| C64::new(0.0, omega * k).exp() * w[c])
+                        .sum();
+                    let exact: C64 = gaussians(set, c)
+                        .iter()
+                        .map(|g| {
+                            g.amplitude
+                                * C64::new(-0.5 * (g.sigma * omega).powi(2), omega * g.mu).exp()
+                        })
+                        .sum();
+                    // Between grid points the error can exceed the grid's running maximum only
+                    // by its variation over one step (tiny: 512 steps per rule's range).
+                    let e = (sum - exact).norm();
+                    assert!(
+                        e <= 1.5 * r.error_at(omega) + 1e-12,
+                        "{set:?} {c} {omega}: {e}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn panels_grow_with_frequency_and_round_trip() {
+        let set = WeightSet::SrgbD65;
+        let thin = panels(set, 20.0 / 0.011, 0.0, 0.1).unwrap();
+        assert!(panels(set, 40.0 / 0.011, 0.0, 0.1).unwrap() >= thin);
+        assert!(panels(set, 20.0 / 0.011, 0.0, 0.5).unwrap() >= thin);
+        assert_eq!(panels(set, 1e9, 0.0, 0.1), None);
+        assert_eq!(panels(set, f64::NAN, 0.0, 0.1), None);
+        assert_eq!(panels(set, 1.0, 0.0, 1.0), None);
+    }
+}
