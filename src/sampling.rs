@@ -241,6 +241,12 @@ pub enum Spectrum {
 pub const MAX_BANDS: usize = 4;
 
 impl Spectrum {
+    /// True if a channel's weight can be negative (linear sRGB: out-of-gamut colours give a
+    /// negative channel value, which is the colour, not an error).
+    fn is_signed(&self) -> bool {
+        matches!(self, Spectrum::Weights(set) if set.is_signed())
+    }
+
     /// Channels of the answer.
     fn channels(&self) -> Result<usize> {
         match *self {
@@ -421,8 +427,11 @@ fn lobes_of_plate(
             let Some(m) = m else { continue };
             let mut mueller = m * scale;
             // A band-averaged coherency of a plate that passes (almost) nothing can give M00 a
-            // rounding-level negative (seen: -2e-22); the unpolarised throughput is >= 0.
-            mueller[(0, 0)] = mueller[(0, 0)].max(0.0);
+            // rounding-level negative (seen: -2e-22); under a non-negative weight the
+            // unpolarised throughput is >= 0. (A signed sRGB channel keeps its sign.)
+            if !spectrum.is_signed() {
+                mueller[(0, 0)] = mueller[(0, 0)].max(0.0);
+            }
             out[c][component] = Some(PathLobe {
                 component,
                 wo,

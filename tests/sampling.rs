@@ -164,3 +164,54 @@ fn absorbing_exit_keeps_the_front_reflection_only() {
         }
     }
 }
+
+/// Linear sRGB channels are signed: a film whose reflected colour lies outside the sRGB gamut
+/// (lithium niobate, 0.285 um, on silica: a saturated cyan-green, R < 0) keeps its negative R in
+/// the plugin's lobe, equal to the plate integrated over the sRGB weights (only the rounding
+/// guard of non-negative weights clamps at 0). Before this test the lobe clamped R to 0: the
+/// thin_film scene's scalar_rgb image was 0.06 (in units of the light) too red there.
+#[test]
+fn srgb_lobes_keep_negative_channels() {
+    use birefringent::frame::PlaneFrame;
+    use birefringent::material::Material;
+    use birefringent::sampling::{plate_lobes, PlateQuery, Spectrum};
+    use birefringent::slab::Want;
+    use birefringent::spectral::integrate::{integrate_set, Output};
+    use birefringent::spectral::weights::WeightSet;
+    let q = PlateQuery::new(
+        Material::named("linbo3", 0.0, 0.0).unwrap(),
+        0.0,
+        C64::new(1.0, 0.0),
+        C64::new(1.458, 0.0),
+        Vector3::new(1.0, 0.0, 0.0),
+        285.0,
+        true,
+        true,
+        true,
+    )
+    .unwrap()
+    .with_absorbing_exit(true);
+    let theta = 40f64.to_radians();
+    let wi = Vector3::new(0.0, -theta.sin(), theta.cos());
+    let spectrum = Spectrum::Weights(WeightSet::SrgbD65);
+    let lobes = plate_lobes(&q, &spectrum, wi, Transport::Radiance).unwrap();
+    // Radiance: the core solves the plate for light arriving from the reflected direction.
+    let wo = Vector3::new(0.0, theta.sin(), theta.cos());
+    let direct = integrate_set(
+        &q.plate,
+        &PlaneFrame::from_direction(wo),
+        C64::new(theta.sin(), 0.0),
+        WeightSet::SrgbD65,
+        Want {
+            reflection: true,
+            transmission: false,
+        },
+        Output::Intensity,
+    )
+    .unwrap();
+    let r = lobes[0][0].unwrap().weight;
+    let expected = direct[0].r.unwrap()[(0, 0)];
+    assert!(expected < -0.01, "R = {expected}: not out of gamut");
+    // Same computation through the lobe (scale 1 in reflection): equal to rounding.
+    assert!((r - expected).abs() < 1e-12, "lobe R {r} vs {expected}");
+}

@@ -22,7 +22,7 @@
 //! Gaussian (σ ≤ [`NARROW_BAND`] μ) through any plate is the matrix etalon of
 //! [`crate::spectral::narrow`] where its residual phases are resolved by a few nodes. The
 //! shared quadrature of [`integrate_set`] interpolates a dispersive plate's interface blocks
-//! across the band ([`crate::spectral::interpolate`]) and sizes its panels order by order
+//! across the band ([`crate::spectral::interpolate`]) and sizes its rule order by order
 //! ([`crate::spectral::shared`]).
 
 use crate::cmath;
@@ -436,7 +436,7 @@ pub fn integrate_set(
         }
     }
     match shared::plan(plate, frame, beta, set)? {
-        Some(panels) => shared::quadrature(plate, frame, beta, set, panels, want, output),
+        Some(points) => shared::quadrature(plate, frame, beta, set, points, want, output),
         None => {
             let one = |c: usize| integrate(plate, frame, beta, bands[c], want, output);
             Ok([one(0)?, one(1)?, one(2)?])

@@ -1,12 +1,19 @@
 //! One quadrature of the exact plate shared by the three channels of a weight set, for plates
 //! whose spectrum varies slowly over the visible range (thin plates and films).
 //!
-//! `∫ w_c(k) M(k) dk` for the channels `c` of a fitted weight set ([`gaussians`]) by composite
-//! 8-point Gauss–Legendre over the weights' support `[lo, hi]` (every Gaussian's `μ ± 6σ`):
-//! each node solves the plate once (its interface blocks interpolated across the band,
-//! [`BlockInterpolant`]) and serves all three channels.
+//! `∫ w_c(k) M(k) dk` for the channels `c` of a fitted weight set ([`gaussians`]) by product
+//! integration on the weights' support `[lo, hi]` (every Gaussian's `μ ± 6σ`): `M` is sampled
+//! at `N` Chebyshev points `k_j` and replaced by its interpolating polynomial, which is
+//! integrated against each weight exactly, `Σ_j W_cj M(k_j)` with
+//! `W_cj = (1/N) Σ_{n<N} (2 − δ_n0) T_n(t_j) μ_cn` and the weight's Chebyshev moments
+//! `μ_cn = ∫ w_c(k) T_n(t(k)) dk` (computed once, in `θ = arccos t`, where every integrand is
+//! smooth). Each point solves the plate once (its interface blocks interpolated across the
+//! band, [`BlockInterpolant`]) and serves all three channels. Interpolation on Chebyshev points
+//! resolves an oscillation of `Φ` radians across the support with about `Φ/2` points (composite
+//! Gauss–Legendre needs ~4 per radian of `Φ/π`, i.e. twice as many, and more to resolve the
+//! weights' own shape, which the moments here take exactly).
 //!
-//! **How many panels.** The plate's spectrum is a sum of oscillations `A(k) e^{iωk}`: the
+//! **How many points.** The plate's spectrum is a sum of oscillations `A(k) e^{iωk}`: the
 //! direct paths' birefringent phase difference (amplitude up to 1, `ω ≤ ω_b`, the largest
 //! difference of the modes' group paths), and per order `n` of internal round trips an
 //! amplitude of at most `a_n = ρⁿ / (1 − ρ)²` relative to the direct light (`ρ` the norm of the
@@ -17,10 +24,10 @@
 //! used is the smallest of [`LADDER`] whose error, times each oscillation's amplitude, stays
 //! below [`TOLERANCE`] for every channel (frequencies × [`SPAN_MARGIN`]): low orders, which
 //! carry the light, are resolved to many digits, high orders only as far as their weight needs,
-//! and the fitted weights' own shape is resolved too.
+//! and the weights' shape is in the moments.
 //!
-//! **The nodes and their weights** depend only on the weight set and the panel count: they are
-//! computed once per (set, rung of the ladder) and kept, with the rule's error table.
+//! **The points and their weights** depend only on the weight set and the number of points:
+//! they are computed once per (set, rung of [`LADDER`]) and kept, with the rule's error table.
 
 use crate::error::Result;
 use crate::frame::PlaneFrame;
@@ -35,24 +42,29 @@ use num_complex::Complex64 as C64;
 use std::f64::consts::TAU;
 use std::sync::OnceLock;
 
-/// Largest error (absolute, in units of the light carried by the direct paths) a panel may make
-/// on any order of round trips: far below anything visible (a CIEDE2000 of 1 is ~1e-2 of the
-/// signal) and below the fitted weights' own error.
-pub const TOLERANCE: f64 = 1e-7;
+/// Largest error (absolute, in units of the light carried by the direct paths) the rule may make
+/// on any oscillation: 1/200 of the fitted weights' own error bound (the L1 norm of the fit
+/// residual, 1.7e-3 to 2.8e-3 per channel, [`crate::spectral::weights::fourier_error_bound`])
+/// and a thousand times below a visible difference (a CIEDE2000 of 1 is ~1e-2 of the signal).
+pub const TOLERANCE: f64 = 1e-5;
 
 /// Margin on the estimated phase span `Φ` (the group round trip is evaluated at the support's
 /// centre and short end; elsewhere it can be larger by a few per cent).
 pub const SPAN_MARGIN: f64 = 1.3;
 
-/// Panel counts the rule is rounded up to (at most 128 panels: 1024 plate evaluations).
-pub const LADDER: [usize; 17] = [
-    8, 10, 12, 14, 16, 20, 24, 28, 32, 40, 48, 56, 64, 80, 96, 112, 128,
+/// Numbers of Chebyshev points of the rules (at most 1024 plate evaluations).
+pub const LADDER: [usize; 25] = [
+    16, 20, 24, 28, 32, 40, 48, 56, 64, 80, 96, 112, 128, 160, 192, 224, 256, 320, 384, 448, 512,
+    640, 768, 896, 1024,
 ];
 
-/// The nodes `k` of the composite rule on the weights' support with `panels` panels, each with
-/// its quadrature weight times every channel's fitted weight at `k`.
+/// Chebyshev moments computed per weight set (the largest rung).
+const MOMENTS: usize = 1024;
+
+/// The points `k_j` of a product-integration rule on the weights' support, each with its
+/// weight per channel.
 pub struct Rule {
-    /// `(k, [w Σ_j a_j G_j(k) per channel])`.
+    /// `(k_j, [W_cj per channel])`.
     pub nodes: Vec<(f64, [f64; 3])>,
     /// The support `[lo, hi]` (wavenumbers, 1/nm).
     pub lo: f64,
@@ -65,10 +77,12 @@ pub struct Rule {
     step: f64,
 }
 
-/// Frequencies tabulated per rule, up to a phase of [`PHASE_PER_PANEL`] per panel.
+/// Frequencies tabulated per rule, up to [`PHASE_PER_POINT`] radians per point over the
+/// support's half width.
 const FREQUENCIES: usize = 512;
-/// Beyond this phase per panel an 8-point panel's error exceeds 0.1: no rule is accurate there.
-const PHASE_PER_PANEL: f64 = 28.0;
+/// Beyond about one radian per point (over the half width) interpolation on Chebyshev points
+/// fails (its error is of order 1); the table reaches 1.5.
+const PHASE_PER_POINT: f64 = 1.5;
 
 impl Rule {
     /// The rule's largest error on any oscillation `e^{iω'k}` with `ω' ≤ omega` (1 beyond
@@ -128,30 +142,35 @@ pub fn support(set: WeightSet) -> (f64, f64) {
     (lo, hi)
 }
 
-/// The rule for `set` with `panels` (a rung of [`LADDER`]), computed once.
-pub fn rule(set: WeightSet, panels: usize) -> &'static Rule {
+/// The rule for `set` with `points` (rounded up to a rung of [`LADDER`]), computed once.
+pub fn rule(set: WeightSet, points: usize) -> &'static Rule {
     const SETS: usize = WeightSet::ALL.len();
     static RULES: [[OnceLock<Rule>; LADDER.len()]; SETS] =
         [const { [const { OnceLock::new() }; LADDER.len()] }; SETS];
     let rung = LADDER
         .iter()
-        .position(|&r| r >= panels)
+        .position(|&r| r >= points)
         .unwrap_or(LADDER.len() - 1);
     RULES[set.index()][rung].get_or_init(|| {
         let (lo, hi) = support(set);
-        let nodes: Vec<(f64, [f64; 3])> = hermite::composite_interval(lo, hi, LADDER[rung])
-            .into_iter()
-            .map(|(k, w)| {
-                let channel = |c: usize| -> f64 {
-                    gaussians(set, c)
-                        .iter()
-                        .map(|g| g.amplitude * normal_pdf(k, g))
-                        .sum()
-                };
-                (k, [0, 1, 2].map(|c| w * channel(c)))
+        let n = LADDER[rung];
+        let mu = moments(set);
+        let nodes: Vec<(f64, [f64; 3])> = (0..n)
+            .map(|j| {
+                let theta = std::f64::consts::PI * (j as f64 + 0.5) / n as f64;
+                let k = 0.5 * (lo + hi) + 0.5 * (hi - lo) * theta.cos();
+                let mut w = [0.0; 3];
+                for (m, moment) in mu.iter().take(n).enumerate() {
+                    let scale = if m == 0 { 1.0 } else { 2.0 } / n as f64;
+                    let t = scale * (m as f64 * theta).cos();
+                    for (wc, mc) in w.iter_mut().zip(moment) {
+                        *wc += t * mc;
+                    }
+                }
+                (k, w)
             })
             .collect();
-        let step = PHASE_PER_PANEL * LADDER[rung] as f64 / (hi - lo) / FREQUENCIES as f64;
+        let step = PHASE_PER_POINT * n as f64 / (0.5 * (hi - lo)) / FREQUENCIES as f64;
         let error = Rule::tabulate(set, &nodes, step);
         Rule {
             nodes,
@@ -163,13 +182,49 @@ pub fn rule(set: WeightSet, panels: usize) -> &'static Rule {
     })
 }
 
+/// The Chebyshev moments `μ_cn = ∫ w_c(k) T_n(t(k)) dk` of a weight set on its support,
+/// `n < `[`MOMENTS`], computed once: in `θ` (`t = cos θ`, `dk = (hi − lo)/2 sin θ dθ`) by
+/// 2048 panels of 8-point Gauss–Legendre over `[0, π]` (at least 4 panels per period of
+/// `cos(nθ)`: exact to rounding).
+fn moments(set: WeightSet) -> &'static [[f64; 3]] {
+    const SETS: usize = WeightSet::ALL.len();
+    static MOMENTS_OF: [OnceLock<Vec<[f64; 3]>>; SETS] = [const { OnceLock::new() }; SETS];
+    MOMENTS_OF[set.index()].get_or_init(|| {
+        let (lo, hi) = support(set);
+        let mut mu = vec![[0.0; 3]; MOMENTS];
+        for (theta, w) in hermite::composite_interval(0.0, std::f64::consts::PI, 2048) {
+            let t = theta.cos();
+            let k = 0.5 * (lo + hi) + 0.5 * (hi - lo) * t;
+            let jac = w * 0.5 * (hi - lo) * theta.sin();
+            let weight = [0, 1, 2].map(|c| {
+                jac * gaussians(set, c)
+                    .iter()
+                    .map(|g| g.amplitude * normal_pdf(k, g))
+                    .sum::<f64>()
+            });
+            // T_n(t) = cos(nθ) by the recurrence.
+            let (mut previous, mut current) = (1.0, t);
+            for (n, m) in mu.iter_mut().enumerate() {
+                let tn = if n == 0 { 1.0 } else { current };
+                for (mc, wc) in m.iter_mut().zip(weight) {
+                    *mc += tn * wc;
+                }
+                if n > 0 {
+                    (previous, current) = (current, 2.0 * t * current - previous);
+                }
+            }
+        }
+        mu
+    })
+}
+
 /// The unit-mass normal density `G(k; μ, σ)`.
 fn normal_pdf(k: f64, g: &Gaussian) -> f64 {
     let z = (k - g.mu) / g.sigma;
     (-0.5 * z * z).exp() / (g.sigma * TAU.sqrt())
 }
 
-/// The panel count the shared quadrature needs for this plate and weight set (module docs), or
+/// The number of points the shared quadrature needs for this plate and weight set (module docs), or
 /// `None` if the plate's spectrum oscillates too fast for one shared rule (then each Gaussian
 /// is integrated on its own).
 pub fn plan(plate: &Plate, frame: &PlaneFrame, beta: C64, set: WeightSet) -> Result<Option<usize>> {
@@ -186,12 +241,12 @@ pub fn plan(plate: &Plate, frame: &PlaneFrame, beta: C64, set: WeightSet) -> Res
         split = split.max(group_splitting(&optics, &disp, k));
     }
     let d = plate.thickness_nm;
-    Ok(panels(set, d * trip, d * split, rho))
+    Ok(points(set, d * trip, d * split, rho))
 }
 
 /// The smallest rung of [`LADDER`] whose rule integrates oscillations of amplitude 1 up to
 /// `omega_b` and of amplitude `a_n` up to `n omega_1 + omega_b` to [`TOLERANCE`] (module docs).
-pub fn panels(set: WeightSet, omega_1: f64, omega_b: f64, rho: f64) -> Option<usize> {
+pub fn points(set: WeightSet, omega_1: f64, omega_b: f64, rho: f64) -> Option<usize> {
     if !(omega_1.is_finite() && omega_b.is_finite() && (0.0..1.0).contains(&rho)) {
         return None;
     }
@@ -217,18 +272,18 @@ pub fn panels(set: WeightSet, omega_1: f64, omega_b: f64, rho: f64) -> Option<us
     })
 }
 
-/// `∫ w_c(k) M(k) dk` for the three channels of `set` with the shared rule of `panels` panels
+/// `∫ w_c(k) M(k) dk` for the three channels of `set` with the shared rule of `points` points
 /// (module docs).
 pub fn quadrature(
     plate: &Plate,
     frame: &PlaneFrame,
     beta: C64,
     set: WeightSet,
-    panels: usize,
+    points: usize,
     want: Want,
     output: Output,
 ) -> Result<[SlabMueller; 3]> {
-    let rule = rule(set, panels);
+    let rule = rule(set, points);
     // The blocks at each node: fixed without dispersion; else interpolated across the band
     // (checked; exact at every node where the interpolant is refused).
     let exact =
@@ -306,13 +361,13 @@ mod tests {
     }
 
     #[test]
-    fn panels_grow_with_frequency_and_round_trip() {
+    fn points_grow_with_frequency_and_round_trip() {
         let set = WeightSet::SrgbD65;
-        let thin = panels(set, 20.0 / 0.011, 0.0, 0.1).unwrap();
-        assert!(panels(set, 40.0 / 0.011, 0.0, 0.1).unwrap() >= thin);
-        assert!(panels(set, 20.0 / 0.011, 0.0, 0.5).unwrap() >= thin);
-        assert_eq!(panels(set, 1e9, 0.0, 0.1), None);
-        assert_eq!(panels(set, f64::NAN, 0.0, 0.1), None);
-        assert_eq!(panels(set, 1.0, 0.0, 1.0), None);
+        let thin = points(set, 20.0 / 0.011, 0.0, 0.1).unwrap();
+        assert!(points(set, 40.0 / 0.011, 0.0, 0.1).unwrap() >= thin);
+        assert!(points(set, 20.0 / 0.011, 0.0, 0.5).unwrap() >= thin);
+        assert_eq!(points(set, 1e9, 0.0, 0.1), None);
+        assert_eq!(points(set, f64::NAN, 0.0, 0.1), None);
+        assert_eq!(points(set, 1.0, 0.0, 1.0), None);
     }
 }

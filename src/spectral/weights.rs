@@ -63,6 +63,12 @@ impl WeightSet {
         }
     }
 
+    /// True if some channel's weight is negative somewhere (linear sRGB's colour matching
+    /// functions are; XYZ's are not).
+    pub fn is_signed(self) -> bool {
+        self == WeightSet::SrgbD65
+    }
+
     pub(crate) fn index(self) -> usize {
         match self {
             WeightSet::XyzE => 0,
