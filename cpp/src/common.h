@@ -7,6 +7,7 @@
  */
 #pragma once
 
+#include <optional>
 #include <mitsuba/core/plugin.h>
 #include <mitsuba/core/properties.h>
 #include <mitsuba/core/string.h>
@@ -146,33 +147,62 @@ template <typename Float, typename Spectrum> struct Lobes {
     static Vec3d v3(const double *v) { return Vec3d(v[0], v[1], v[2]); }
     static Vec3d v3(const Vector3f &v) { return Vec3d(v.x(), v.y(), v.z()); }
 
-    /// The lobe's physical Mueller matrix (core frames in_stokes_x -> out_stokes_x) expressed in
-    /// Mitsuba's implicit frames stokes_basis(-wo_hat) -> stokes_basis(wi_hat), where
-    /// (wo_hat, wi_hat) = (wo, wi) in Radiance mode and (wi, wo) in Importance mode. `wo` is the
-    /// direction handed to Mitsuba (float), so the frames are exactly the integrator's.
-    static Mueller4d implicit_frames(const bfr_path_lobe &l, const Vector3f &wi,
-                                     const Vector3f &wo, bool radiance) {
-        Mueller4d M;
-        for (size_t r = 0; r < 4; ++r)
-            for (size_t c = 0; c < 4; ++c)
-                M(r, c) = l.mueller[4 * r + c];
-        Vec3d wo_hat = v3(radiance ? wo : wi), wi_hat = v3(radiance ? wi : wo);
-        Vec3d k_in = -wo_hat;
-        return mueller::rotate_mueller_basis(M, k_in, v3(l.in_stokes_x),
-                                             mueller::stokes_basis(k_in), wi_hat,
-                                             v3(l.out_stokes_x), mueller::stokes_basis(wi_hat));
-    }
+    /// The rotations that express a lobe's physical Mueller matrix (core frames in_stokes_x ->
+    /// out_stokes_x) in Mitsuba's implicit frames stokes_basis(-wo_hat) -> stokes_basis(wi_hat),
+    /// where (wo_hat, wi_hat) = (wo, wi) in Radiance mode and (wi, wo) in Importance mode: the
+    /// matrix is R_out M R_in^T (mueller::rotate_mueller_basis). `wo` is the direction handed
+    /// to Mitsuba (float), so the frames are exactly the integrator's.
+    struct Frames {
+        double in_x[3], out_x[3];
+        Mueller4d r_out, r_in_t;
+
+        Frames(const bfr_path_lobe &l, const Vector3f &wi, const Vector3f &wo, bool radiance) {
+            for (int k = 0; k < 3; ++k) {
+                in_x[k] = l.in_stokes_x[k];
+                out_x[k] = l.out_stokes_x[k];
+            }
+            Vec3d wo_hat = v3(radiance ? wo : wi), wi_hat = v3(radiance ? wi : wo);
+            Vec3d k_in = -wo_hat;
+            r_in_t = dr::transpose(mueller::rotate_stokes_basis(k_in, v3(l.in_stokes_x),
+                                                                mueller::stokes_basis(k_in)));
+            r_out = mueller::rotate_stokes_basis(wi_hat, v3(l.out_stokes_x),
+                                                 mueller::stokes_basis(wi_hat));
+        }
+
+        /// True if lobe `l` has the same core frames (then the same rotations apply).
+        bool fits(const bfr_path_lobe &l) const {
+            for (int k = 0; k < 3; ++k)
+                if (in_x[k] != l.in_stokes_x[k] || out_x[k] != l.out_stokes_x[k])
+                    return false;
+            return true;
+        }
+
+        Mueller4d apply(const bfr_path_lobe &l) const {
+            Mueller4d M;
+            for (size_t r = 0; r < 4; ++r)
+                for (size_t c = 0; c < 4; ++c)
+                    M(r, c) = l.mueller[4 * r + c];
+            return r_out * M * r_in_t;
+        }
+    };
 
     /// Spectrum of one lobe: channel ch takes lobes[ch * n_lobes + pick[ch]] times `scale`, or 0
-    /// where pick[ch] < 0. Unpolarised variants use the weight (M00) only.
+    /// where pick[ch] < 0. Unpolarised variants use the weight (M00) only. Polarised variants
+    /// rotate each channel's Mueller matrix into Mitsuba's frames; channels whose lobes share
+    /// the core frames (all of them unless a crystal's o/e frames differ per wavelength) share
+    /// the rotations.
     static Spectrum spectrum(const bfr_path_lobe *lobes, size_t n_lobes, const int *pick,
                              double scale, const Vector3f &wi, const Vector3f &wo, bool radiance) {
         if constexpr (is_polarized_v<Spectrum>) {
             Spectrum out = dr::zeros<Spectrum>();
+            std::optional<Frames> frames;
             for (size_t ch = 0; ch < Channels; ++ch) {
                 if (pick[ch] < 0)
                     continue;
-                Mueller4d M = implicit_frames(lobes[ch * n_lobes + pick[ch]], wi, wo, radiance);
+                const bfr_path_lobe &l = lobes[ch * n_lobes + pick[ch]];
+                if (!frames || !frames->fits(l))
+                    frames.emplace(l, wi, wo, radiance);
+                Mueller4d M = frames->apply(l);
                 for (size_t r = 0; r < 4; ++r)
                     for (size_t c = 0; c < 4; ++c)
                         out(r, c)[ch] = (ScalarFloat) (M(r, c) * scale);
