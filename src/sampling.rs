@@ -412,9 +412,13 @@ fn lobes_of_plate(
             reflection: component == 0,
             transmission: component == 1,
         };
-        let ms = match &shared {
-            Some(ms) => ms.clone(),
-            None => physical_plate(q, spectrum, towards, want)?,
+        let own;
+        let ms: &[SlabMueller] = match &shared {
+            Some(ms) => ms,
+            None => {
+                own = physical_plate(q, spectrum, towards, want)?;
+                &own
+            }
         };
         let (n_in, n_out) = side_indices(q, towards, component);
         let scale = match transport {
