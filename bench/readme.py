@@ -69,19 +69,29 @@ def section(r: dict) -> str:
         "per-wavelength sampling needs to reach the error of the method, divided by the method's time "
         "(goal for the thin film with scalar_rgb: >= 50):",
         "",
-        "| scene | method | method's spp | its error | its time (s) | exact sampling's time (s) | ratio |",
-        "| --- | --- | --- | --- | --- | --- | --- |",
+        "| scene | image | method | method's spp | its error | its time (s) | exact sampling's time (s) | ratio |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
     label = {"rgb": "analytic RGB (scalar_rgb)", "filter": "4 nm band filter"}
+    frames = r["settings"].get("frames", {})
     for scene, d in r["equal_error_detail"].items():
         flag = " (extrapolated)" if d["extrapolated"] else ""
-        lines.append(f"| {scene} | {label[d['method']]} | {d['spp']} | {d['error']:.3f} | "
+        lines.append(f"| {scene} | {image(frames.get(scene))} | {label[d['method']]} | {d['spp']} | {d['error']:.3f} | "
                      f"{d['seconds']:.2f} | {d['exact_seconds_at_error']:.2f} | {d['ratio']:.3g}{flag} |")
     lines += ["", "**Shortcuts** (speed of the full computation's time over the shortcut's):", "",
               "| shortcut | speed ratio |", "| --- | --- |"]
     for k, v in r["shortcuts"].items():
         lines.append(f"| {SHORTCUT_TEXT.get(k, k)} | {v:.2f} |")
     return "\n".join(lines)
+
+
+def image(frame: dict | None) -> str:
+    """'32x32', or '32x32 crop of 256x256' for a scene rendered as a crop (bench/scenes.py CROPS)."""
+    if not frame:
+        return "?"
+    w, h = frame["crop"][2:]
+    full = frame["size"]
+    return f"{w}x{h}" if [w, h] == full else f"{w}x{h} crop of {full[0]}x{full[1]}"
 
 
 def main() -> int:
