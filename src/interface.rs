@@ -6,14 +6,16 @@
 //! Tangential `E` and `H` are continuous across `z = 0`; writing every field as a sum of modes,
 //! `Ψ₁↓ a + Ψ₁↑ b = Ψ₂↓ c + Ψ₂↑ d` with the known incoming amplitudes `a` (from above) and `d`
 //! (from below). Solving `[Ψ₁↑ −Ψ₂↓] [b; c] = [−Ψ₁↓ Ψ₂↑] [a; d]` gives the full scattering
-//! matrix `S` of the interface: `[b; c] = S [a; d]`. This one solve covers iso→aniso,
-//! aniso→iso and aniso→aniso interfaces alike.
+//! matrix `S` of the interface: `[b; c] = S [a; d]`. This one solve ([`Interface::from_modes`])
+//! covers iso→aniso, aniso→iso and aniso→aniso interfaces alike; when one side is isotropic,
+//! [`Interface::solve`] reduces it to a 2x2 solve ([`crate::admittance`]) with the same `S`.
 
+use crate::admittance::{self, M2};
 use crate::cmath;
 use crate::error::{Error, Result};
 use crate::fresnel::Fresnel;
 use crate::medium::Uniaxial;
-use crate::modes::{modes, Mode, ModeSet};
+use crate::modes::{modes, Mode, ModeKind, ModeSet};
 use nalgebra::{Matrix2, Matrix4};
 use num_complex::Complex64 as C64;
 
@@ -48,7 +50,47 @@ impl Interface {
             let f = Fresnel::new(upper.eta_o, lower.eta_o, beta).ok_or_else(singular)?;
             return Ok(Self::isotropic(m1, m2, &f));
         }
-        Self::from_modes(m1, m2)
+        Self::solve(m1, m2)
+    }
+
+    /// Solves the boundary system for mode sets as [`modes`] gives them: by the admittance
+    /// reduction ([`crate::admittance`], one 2x2 solve) when either side has s/p modes (an
+    /// isotropic medium), else by the general 4x4 solve ([`Interface::from_modes`]). The same
+    /// scattering matrix either way, to rounding (`tests/interface_fast_path.rs`).
+    pub fn solve(upper: ModeSet, lower: ModeSet) -> Result<Self> {
+        if is_sp(&upper) {
+            Self::iso_above(upper, lower)
+        } else if is_sp(&lower) {
+            Self::iso_below(upper, lower)
+        } else {
+            Self::from_modes(upper, lower)
+        }
+    }
+
+    /// Isotropic upper medium: its incoming waves go down, the other medium's go up.
+    fn iso_above(upper: ModeSet, lower: ModeSet) -> Result<Self> {
+        let r = admittance::solve(
+            &tangential(&upper.down),
+            &tangential(&upper.up),
+            &tangential(&lower.up),
+            &tangential(&lower.down),
+        )
+        .ok_or_else(singular)?;
+        let s = assemble([[r.r_iso, r.t_to_iso], [r.t_from_iso, r.r_other]])?;
+        Ok(Interface { upper, lower, s })
+    }
+
+    /// Isotropic lower medium: its incoming waves go up, the other medium's go down.
+    fn iso_below(upper: ModeSet, lower: ModeSet) -> Result<Self> {
+        let r = admittance::solve(
+            &tangential(&lower.up),
+            &tangential(&lower.down),
+            &tangential(&upper.down),
+            &tangential(&upper.up),
+        )
+        .ok_or_else(singular)?;
+        let s = assemble([[r.r_other, r.t_from_iso], [r.t_to_iso, r.r_iso]])?;
+        Ok(Interface { upper, lower, s })
     }
 
     /// The interface of two isotropic media from its Fresnel amplitudes: every block of `S`
@@ -127,6 +169,29 @@ impl Interface {
         let (d, u) = (&self.upper.down, &self.lower.up);
         [&d[0], &d[1], &u[0], &u[1]].map(carried)
     }
+}
+
+/// True for the s/p pair of an isotropic medium ([`crate::modes::isotropic_modes`]): the s
+/// mode has only `(E_y, H_x)`, the p mode only `(E_x, H_y)`, which the admittance reduction needs.
+fn is_sp(m: &ModeSet) -> bool {
+    let sp = |p: &[Mode; 2]| p[0].kind == ModeKind::S && p[1].kind == ModeKind::P;
+    sp(&m.down) && sp(&m.up)
+}
+
+/// The tangential fields `ψ` of a pair of modes.
+#[inline]
+fn tangential(pair: &[Mode; 2]) -> [[C64; 4]; 2] {
+    [pair[0].tangential(), pair[1].tangential()]
+}
+
+/// The 4x4 scattering matrix from its 2x2 blocks `[[S₀₀, S₀₁], [S₁₀, S₁₁]]`; the singular
+/// error if any entry is not finite (as [`Interface::from_modes`]).
+fn assemble(blocks: [[M2; 2]; 2]) -> Result<Matrix4<C64>> {
+    let s = Matrix4::from_fn(|i, j| blocks[i / 2][j / 2][i % 2][j % 2]);
+    if s.iter().any(|z| !z.re.is_finite() || !z.im.is_finite()) {
+        return Err(singular());
+    }
+    Ok(s)
 }
 
 /// The power a mode carries through the surface: `|P|`, or 0 if it is evanescent.

@@ -5,6 +5,7 @@
 //! Everything is computed in `f64`. Time convention: `exp(i (k·r − ω t))`, absorbing indices
 //! `n + iκ` with `κ ≥ 0`.
 
+pub mod admittance;
 pub mod calc;
 pub mod cmath;
 pub mod crystals;

@@ -127,8 +127,8 @@ impl Slab {
     pub fn optics(&self, frame: &PlaneFrame, beta: C64) -> Result<SlabOptics> {
         let layer = self.layer.with_axis(frame.to_working(self.layer.axis));
         let inner = modes(&layer, beta);
-        let top = Interface::from_modes(modes(&self.top, beta), inner)?;
-        let bottom = Interface::from_modes(inner, modes(&self.bottom, beta))?;
+        let top = Interface::solve(modes(&self.top, beta), inner)?;
+        let bottom = Interface::solve(inner, modes(&self.bottom, beta))?;
         Ok(SlabOptics {
             top,
             bottom,
