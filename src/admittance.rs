@@ -23,26 +23,32 @@
 //! polarisation (`E` or `H` row, whichever coefficient of `O` is larger). The 4x4 system is
 //! singular exactly when `L` is (the eliminating transformation is invertible: `e^O_s = 1`).
 
+use crate::cmath;
 use num_complex::Complex64 as C64;
 
 /// A complex 2x2 matrix as rows.
 pub type M2 = [[C64; 2]; 2];
 
-/// The four blocks of the scattering matrix of an interface with one isotropic side.
+/// Outgoing amplitudes for unit incoming ones: rows are the outgoing waves (two each side),
+/// columns the incoming waves `[x_in s, x_in p, y_in 0, y_in 1]`.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Reduced {
-    /// Isotropic outgoing ← isotropic incoming (reflection on the isotropic side).
-    pub r_iso: M2,
-    /// Other side outgoing ← isotropic incoming (transmission into the other medium).
-    pub t_from_iso: M2,
-    /// Isotropic outgoing ← other side incoming (transmission into the isotropic medium).
-    pub t_to_iso: M2,
-    /// Other side outgoing ← other side incoming (reflection on the other side).
-    pub r_other: M2,
+pub struct Solution {
+    /// Outgoing waves of the isotropic medium, `[s, p]`.
+    pub x: [[C64; 4]; 2],
+    /// Outgoing waves of the other medium.
+    pub y: [[C64; 4]; 2],
 }
 
-/// Components `(E, H)` of `ψ` matched for polarisation `k` (0: s, 1: p) of an isotropic mode.
-const ROWS: [(usize, usize); 2] = [(1, 2), (0, 3)];
+/// The `(E, H)` components of `ψ = (E_x, E_y, H_x, H_y)` matched for polarisation `k`
+/// (0: s, `(E_y, H_x)`; 1: p, `(E_x, H_y)`).
+#[inline(always)]
+fn eh(psi: &[C64; 4], k: usize) -> (C64, C64) {
+    if k == 0 {
+        (psi[1], psi[2])
+    } else {
+        (psi[0], psi[3])
+    }
+}
 
 /// Solves the boundary system with the isotropic medium's modes `iso_in`, `iso_out` (`[s, p]`,
 /// tangential `ψ`) and the other medium's `other_in`, `other_out` (any two modes each).
@@ -53,12 +59,16 @@ pub fn solve(
     iso_out: &[[C64; 4]; 2],
     other_in: &[[C64; 4]; 2],
     other_out: &[[C64; 4]; 2],
-) -> Option<Reduced> {
-    let mut l = [[C64::new(0.0, 0.0); 2]; 2];
-    let mut rhs = [[C64::new(0.0, 0.0); 4]; 2];
-    for (k, &(e, h)) in ROWS.iter().enumerate() {
-        let (eo, ho) = (iso_out[k][e], iso_out[k][h]);
-        let c = |psi: &[C64; 4]| ho * psi[e] - eo * psi[h];
+) -> Option<Solution> {
+    let zero = C64::new(0.0, 0.0);
+    let mut l = [[zero; 2]; 2];
+    let mut rhs = [[zero; 4]; 2];
+    for k in 0..2 {
+        let (eo, ho) = eh(&iso_out[k], k);
+        let c = |psi: &[C64; 4]| {
+            let (e, h) = eh(psi, k);
+            ho * e - eo * h
+        };
         rhs[k][k] = c(&iso_in[k]);
         for j in 0..2 {
             l[k][j] = c(&other_out[j]);
@@ -66,46 +76,45 @@ pub fn solve(
         }
     }
     let y = solve2(&l, &rhs)?;
-    let x = back_substitute(iso_in, iso_out, other_in, other_out, &y);
-    let block =
-        |m: &[[C64; 4]; 2], col: usize| [[m[0][col], m[0][col + 1]], [m[1][col], m[1][col + 1]]];
-    Some(Reduced {
-        r_iso: block(&x, 0),
-        t_from_iso: block(&y, 0),
-        t_to_iso: block(&x, 2),
-        r_other: block(&y, 2),
-    })
+    let x = [
+        back_substitute(0, iso_in, iso_out, other_in, other_out, &y),
+        back_substitute(1, iso_in, iso_out, other_in, other_out, &y),
+    ];
+    Some(Solution { x, y })
 }
 
-/// The isotropic outgoing amplitudes `x_out` for unit incoming amplitudes `[x_in; y_in]`
-/// (columns), given the other medium's outgoing ones `y` (rows of `y_out`, same columns): one
-/// row of `I x_in + O x_out = A_out y_out + A_in y_in` per polarisation, the `E` row or the
-/// `H` row, whichever has the larger coefficient of the outgoing wave.
-#[inline]
+/// Row `k` (polarisation) of the isotropic outgoing amplitudes `x_out` for unit incoming
+/// amplitudes `[x_in; y_in]` (columns), given the other medium's outgoing ones `y`: one row
+/// of `I x_in + O x_out = A_out y_out + A_in y_in`, the `E` row or the `H` row of the
+/// polarisation, whichever has the larger coefficient of the outgoing wave.
+#[inline(always)]
 fn back_substitute(
+    k: usize,
     iso_in: &[[C64; 4]; 2],
     iso_out: &[[C64; 4]; 2],
     other_in: &[[C64; 4]; 2],
     other_out: &[[C64; 4]; 2],
     y: &[[C64; 4]; 2],
-) -> [[C64; 4]; 2] {
-    let mut x = [[C64::new(0.0, 0.0); 4]; 2];
-    for (k, &(e, h)) in ROWS.iter().enumerate() {
-        let row = if iso_out[k][e].norm_sqr() >= iso_out[k][h].norm_sqr() {
+) -> [C64; 4] {
+    let (eo, ho) = eh(&iso_out[k], k);
+    let e_row = eo.norm_sqr() >= ho.norm_sqr();
+    let pick = |psi: &[C64; 4]| {
+        let (e, h) = eh(psi, k);
+        if e_row {
             e
         } else {
             h
-        };
-        let inv = iso_out[k][row].inv();
-        for (col, out) in x[k].iter_mut().enumerate() {
-            let mut v = other_out[0][row] * y[0][col] + other_out[1][row] * y[1][col];
-            if col == k {
-                v -= iso_in[k][row];
-            } else if col >= 2 {
-                v += other_in[col - 2][row];
-            }
-            *out = v * inv;
         }
+    };
+    let inv = cmath::inv(pick(&iso_out[k]));
+    let (a0, a1) = (pick(&other_out[0]), pick(&other_out[1]));
+    let mut constant = [C64::new(0.0, 0.0); 4];
+    constant[k] = -pick(&iso_in[k]);
+    constant[2] = pick(&other_in[0]);
+    constant[3] = pick(&other_in[1]);
+    let mut x = constant;
+    for (col, v) in x.iter_mut().enumerate() {
+        *v = (a0 * y[0][col] + a1 * y[1][col] + *v) * inv;
     }
     x
 }
@@ -125,13 +134,13 @@ fn solve2(l: &M2, b: &[[C64; 4]; 2]) -> Option<[[C64; 4]; 2]> {
     if negligible(p0, scale) {
         return None;
     }
-    let inv0 = p0.inv();
+    let inv0 = cmath::inv(p0);
     let m = l[bottom][0] * inv0;
     let p1 = l[bottom][1] - m * l[top][1];
     if negligible(p1, scale) {
         return None;
     }
-    let inv1 = p1.inv();
+    let inv1 = cmath::inv(p1);
     let mut x = [[C64::new(0.0, 0.0); 4]; 2];
     for col in 0..4 {
         let x1 = (b[bottom][col] - m * b[top][col]) * inv1;

@@ -24,6 +24,13 @@ pub fn sqrt(z: C64) -> C64 {
     }
 }
 
+/// `1/z` with one real division (`z̄ · (1/|z|²)`); within an ulp or two of `z.inv()`.
+#[inline]
+pub fn inv(z: C64) -> C64 {
+    let r = 1.0 / z.norm_sqr();
+    C64::new(z.re * r, -z.im * r)
+}
+
 /// Solves `A X = B` for a 4×4 complex `A` and 4×4 `B` by Gaussian elimination with partial
 /// pivoting; `None` if `A` is singular to working precision.
 pub fn solve4(a: &Matrix4<C64>, b: &Matrix4<C64>) -> Option<Matrix4<C64>> {

@@ -10,7 +10,7 @@
 //! covers iso→aniso, aniso→iso and aniso→aniso interfaces alike; when one side is isotropic,
 //! [`Interface::solve`] reduces it to a 2x2 solve ([`crate::admittance`]) with the same `S`.
 
-use crate::admittance::{self, M2};
+use crate::admittance;
 use crate::cmath;
 use crate::error::{Error, Result};
 use crate::fresnel::Fresnel;
@@ -44,53 +44,51 @@ impl Interface {
     /// incidence parameter `beta`.
     /// Two isotropic media take the closed-form Fresnel amplitudes ([`Fresnel`]; the same
     /// matrix as the 4x4 solve, which `tests/interface_physics.rs` checks).
+    #[inline]
     pub fn new(upper: &Uniaxial, lower: &Uniaxial, beta: C64) -> Result<Self> {
-        let (m1, m2) = (modes(upper, beta), modes(lower, beta));
         if upper.is_isotropic() && lower.is_isotropic() {
+            let (m1, m2) = (modes(upper, beta), modes(lower, beta));
             let f = Fresnel::new(upper.eta_o, lower.eta_o, beta).ok_or_else(singular)?;
             return Ok(Self::isotropic(m1, m2, &f));
         }
-        Self::solve(m1, m2)
+        // Solved in place: an `Interface` is large, moving it costs.
+        let mut out = Self::unsolved(modes(upper, beta), modes(lower, beta));
+        out.solve_in_place()?;
+        Ok(out)
     }
 
     /// Solves the boundary system for mode sets as [`modes`] gives them: by the admittance
     /// reduction ([`crate::admittance`], one 2x2 solve) when either side has s/p modes (an
     /// isotropic medium), else by the general 4x4 solve ([`Interface::from_modes`]). The same
     /// scattering matrix either way, to rounding (`tests/interface_fast_path.rs`).
+    #[inline]
     pub fn solve(upper: ModeSet, lower: ModeSet) -> Result<Self> {
-        if is_sp(&upper) {
-            Self::iso_above(upper, lower)
-        } else if is_sp(&lower) {
-            Self::iso_below(upper, lower)
-        } else {
-            Self::from_modes(upper, lower)
+        let mut out = Self::unsolved(upper, lower);
+        out.solve_in_place()?;
+        Ok(out)
+    }
+
+    /// The two mode sets with `S = 0`, for [`Interface::solve_in_place`].
+    #[inline]
+    pub(crate) fn unsolved(upper: ModeSet, lower: ModeSet) -> Self {
+        Interface {
+            upper,
+            lower,
+            s: Matrix4::zeros(),
         }
     }
 
-    /// Isotropic upper medium: its incoming waves go down, the other medium's go up.
-    fn iso_above(upper: ModeSet, lower: ModeSet) -> Result<Self> {
-        let r = admittance::solve(
-            &tangential(&upper.down),
-            &tangential(&upper.up),
-            &tangential(&lower.up),
-            &tangential(&lower.down),
-        )
-        .ok_or_else(singular)?;
-        let s = assemble([[r.r_iso, r.t_to_iso], [r.t_from_iso, r.r_other]])?;
-        Ok(Interface { upper, lower, s })
-    }
-
-    /// Isotropic lower medium: its incoming waves go up, the other medium's go down.
-    fn iso_below(upper: ModeSet, lower: ModeSet) -> Result<Self> {
-        let r = admittance::solve(
-            &tangential(&lower.up),
-            &tangential(&lower.down),
-            &tangential(&upper.down),
-            &tangential(&upper.up),
-        )
-        .ok_or_else(singular)?;
-        let s = assemble([[r.r_other, r.t_from_iso], [r.t_to_iso, r.r_iso]])?;
-        Ok(Interface { upper, lower, s })
+    /// Sets `S` from the mode sets ([`Interface::solve`] without moving `self`).
+    #[inline]
+    pub(crate) fn solve_in_place(&mut self) -> Result<()> {
+        self.s = if is_sp(&self.upper) {
+            iso_above(&self.upper, &self.lower)?
+        } else if is_sp(&self.lower) {
+            iso_below(&self.upper, &self.lower)?
+        } else {
+            from_modes_s(&self.upper, &self.lower)?
+        };
+        Ok(())
     }
 
     /// The interface of two isotropic media from its Fresnel amplitudes: every block of `S`
@@ -108,16 +106,7 @@ impl Interface {
 
     /// Solves the boundary system for given mode sets (seed eq. S18).
     pub fn from_modes(upper: ModeSet, lower: ModeSet) -> Result<Self> {
-        let mut lhs = Matrix4::zeros();
-        let mut rhs = Matrix4::zeros();
-        put(&mut lhs, 0, &upper.up, 1.0);
-        put(&mut lhs, 2, &lower.down, -1.0);
-        put(&mut rhs, 0, &upper.down, -1.0);
-        put(&mut rhs, 2, &lower.up, 1.0);
-        let s = cmath::solve4(&lhs, &rhs).ok_or_else(singular)?;
-        if s.iter().any(|z| !z.re.is_finite() || !z.im.is_finite()) {
-            return Err(singular());
-        }
+        let s = from_modes_s(&upper, &lower)?;
         Ok(Interface { upper, lower, s })
     }
 
@@ -171,6 +160,51 @@ impl Interface {
     }
 }
 
+/// `S` by the general 4x4 solve of [`Interface::from_modes`].
+fn from_modes_s(upper: &ModeSet, lower: &ModeSet) -> Result<Matrix4<C64>> {
+    let mut lhs = Matrix4::zeros();
+    let mut rhs = Matrix4::zeros();
+    put(&mut lhs, 0, &upper.up, 1.0);
+    put(&mut lhs, 2, &lower.down, -1.0);
+    put(&mut rhs, 0, &upper.down, -1.0);
+    put(&mut rhs, 2, &lower.up, 1.0);
+    let s = cmath::solve4(&lhs, &rhs).ok_or_else(singular)?;
+    if s.iter().any(|z| !z.re.is_finite() || !z.im.is_finite()) {
+        return Err(singular());
+    }
+    Ok(s)
+}
+
+/// `S` for an isotropic upper medium: its incoming waves go down, the other medium's go up.
+/// Rows `[up₁; down₂]` are the isotropic then the other outgoing waves, columns `[down₁; up₂]`
+/// the isotropic then the other incoming ones: the solution as it comes.
+#[inline]
+fn iso_above(upper: &ModeSet, lower: &ModeSet) -> Result<Matrix4<C64>> {
+    let r = admittance::solve(
+        &tangential(&upper.down),
+        &tangential(&upper.up),
+        &tangential(&lower.up),
+        &tangential(&lower.down),
+    )
+    .ok_or_else(singular)?;
+    assemble([r.x[0], r.x[1], r.y[0], r.y[1]], [0, 1, 2, 3])
+}
+
+/// `S` for an isotropic lower medium: its incoming waves go up, the other medium's go down.
+/// Rows `[up₁; down₂]` are the other then the isotropic outgoing waves, columns `[down₁; up₂]`
+/// the other then the isotropic incoming ones.
+#[inline]
+fn iso_below(upper: &ModeSet, lower: &ModeSet) -> Result<Matrix4<C64>> {
+    let r = admittance::solve(
+        &tangential(&lower.up),
+        &tangential(&lower.down),
+        &tangential(&upper.down),
+        &tangential(&upper.up),
+    )
+    .ok_or_else(singular)?;
+    assemble([r.y[0], r.y[1], r.x[0], r.x[1]], [2, 3, 0, 1])
+}
+
 /// True for the s/p pair of an isotropic medium ([`crate::modes::isotropic_modes`]): the s
 /// mode has only `(E_y, H_x)`, the p mode only `(E_x, H_y)`, which the admittance reduction needs.
 fn is_sp(m: &ModeSet) -> bool {
@@ -184,14 +218,16 @@ fn tangential(pair: &[Mode; 2]) -> [[C64; 4]; 2] {
     [pair[0].tangential(), pair[1].tangential()]
 }
 
-/// The 4x4 scattering matrix from its 2x2 blocks `[[S₀₀, S₀₁], [S₁₀, S₁₁]]`; the singular
-/// error if any entry is not finite (as [`Interface::from_modes`]).
-fn assemble(blocks: [[M2; 2]; 2]) -> Result<Matrix4<C64>> {
-    let s = Matrix4::from_fn(|i, j| blocks[i / 2][j / 2][i % 2][j % 2]);
-    if s.iter().any(|z| !z.re.is_finite() || !z.im.is_finite()) {
+/// The 4x4 scattering matrix from its rows, taking column `j` of `S` from column `cols[j]` of
+/// `rows`; the singular error if any entry is not finite (as [`Interface::from_modes`]).
+#[inline]
+fn assemble(rows: [[C64; 4]; 4], cols: [usize; 4]) -> Result<Matrix4<C64>> {
+    // `0·x` is 0 for a finite `x` and NaN otherwise; the sum keeps a NaN.
+    let check: f64 = rows.iter().flatten().map(|z| z.re * 0.0 + z.im * 0.0).sum();
+    if check != 0.0 {
         return Err(singular());
     }
-    Ok(s)
+    Ok(Matrix4::from_fn(|i, j| rows[i][cols[j]]))
 }
 
 /// The power a mode carries through the surface: `|P|`, or 0 if it is evanescent.

@@ -52,9 +52,9 @@ pub struct Mode {
 }
 
 impl Mode {
+    #[inline]
     fn new(kind: ModeKind, beta: C64, q: C64, e: C3) -> Self {
-        let k = wave_vector(beta, q);
-        let h = k.cross(&e);
+        let h = k_cross(beta, q, &e);
         let flux = 0.5 * (e.x * h.y.conj() - e.y * h.x.conj()).re;
         Mode {
             kind,
@@ -69,11 +69,14 @@ impl Mode {
     /// A lossless propagating e-mode whose flux is evaluated without cancellation: its ray is
     /// `∝ ε k` (seed eq. S12), so `S_z = (S·k) (εk)_z / (kᵀεk)` with `(εk)_z = a q + b = ±w`
     /// known exactly from the root (near `K_max` the direct `½(E×H*)_z` loses digits).
+    #[inline]
     fn lossless_e(beta: C64, q: C64, e: C3, ek_z: f64, kek: f64) -> Self {
         let mut m = Mode::new(ModeKind::E, beta, q, e);
-        let s = m.poynting();
-        let k = Vector3::new(beta.re, 0.0, q.re);
-        m.flux = s.dot(&k) * ek_z / kek;
+        // `S·k` with `k = (β, 0, q)` real: only `S_x` and `S_z` of `½ Re(E × H*)` are needed.
+        let (e, h) = (&m.e, &m.h);
+        let s_x = 0.5 * (e.y * h.z.conj() - e.z * h.y.conj()).re;
+        let s_z = 0.5 * (e.x * h.y.conj() - e.y * h.x.conj()).re;
+        m.flux = (s_x * beta.re + s_z * q.re) * ek_z / kek;
         m
     }
 
@@ -153,8 +156,15 @@ pub fn wave_vector(beta: C64, q: C64) -> C3 {
     Vector3::new(beta, C64::new(0.0, 0.0), q)
 }
 
+/// `k × v` for `k = (β, 0, q)` (seed eq. S2 for `v = E`), written out for the zero `k_y`.
+#[inline]
+fn k_cross(beta: C64, q: C64, v: &C3) -> C3 {
+    Vector3::new(-(q * v.y), q * v.x - beta * v.z, beta * v.y)
+}
+
 /// The normal modes of `medium` (its axis given in the working frame) for incidence parameter
 /// `beta` (seed eqs. S9-S10). Isotropic media get s/p modes.
+#[inline(always)]
 pub fn modes(medium: &Uniaxial, beta: C64) -> ModeSet {
     if medium.is_isotropic() {
         isotropic_modes(medium.eta_o, beta)
@@ -167,11 +177,7 @@ pub fn modes(medium: &Uniaxial, beta: C64) -> ModeSet {
 /// isotropic medium), without the fields: the same roots and branches as [`modes`], at a
 /// fraction of its cost (for the phases of a layer whose amplitudes are known).
 pub fn normal_components(medium: &Uniaxial, beta: C64) -> [C64; 4] {
-    let (qo_up, qo_down) = up_down(
-        C64::new(1.0, 0.0),
-        C64::new(0.0, 0.0),
-        cmath::sqrt(normal_squared(medium.eta_o, beta)),
-    );
+    let (qo_up, qo_down) = up_down(cmath::sqrt(normal_squared(medium.eta_o, beta)));
     if medium.is_isotropic() {
         return [qo_down, qo_down, qo_up, qo_up];
     }
@@ -179,27 +185,35 @@ pub fn normal_components(medium: &Uniaxial, beta: C64) -> [C64; 4] {
     [qo_down, qe_down, qo_up, qe_up]
 }
 
-/// Picks the root pair `(−b ± w)/a` so that the first returned value is the up-going one.
+/// Picks the root pair `(−b ± w)/a` so that the first returned value is the up-going one,
+/// also returning the `w` of the up-going root (`a q⁺ + b = w`, `a q⁻ + b = −w`).
 ///
 /// A mode goes up if it decays upwards (`Im q > 0`); for (numerically) lossless propagation,
 /// where `Im` carries no information, if its Poynting flux points up, which for both o and e
 /// waves is the sign of `Re(w/a)` (the e-wave ray is `∝ ε k`, whose normal part is `a q + b`).
 /// For passive media both criteria agree wherever both apply.
-fn up_down(a: C64, b: C64, w: C64) -> (C64, C64) {
-    let (up, down, _) = up_down_w(a, b, w);
-    (up, down)
+#[inline]
+fn up_down_w(a: C64, b: C64, w: C64) -> (C64, C64, C64) {
+    let inv_a = cmath::inv(a);
+    let w = if goes_down(w * inv_a) { -w } else { w };
+    ((w - b) * inv_a, (-w - b) * inv_a, w)
 }
 
-/// [`up_down`], also returning the `w` of the up-going root (`a q⁺ + b = w`, `a q⁻ + b = −w`).
-fn up_down_w(a: C64, b: C64, w: C64) -> (C64, C64, C64) {
-    let u = w / a;
-    let flip = if u.im.abs() > 1e-9 * u.re.abs() {
+/// [`up_down_w`] for `a = 1`, `b = 0` (o, s and p waves: `q = ±w`), `(q⁺, q⁻)`.
+#[inline]
+fn up_down(w: C64) -> (C64, C64) {
+    let w = if goes_down(w) { -w } else { w };
+    (w, -w)
+}
+
+/// True if the root `q = u` of `q = ±u` is the down-going one (criterion of [`up_down_w`]).
+#[inline]
+fn goes_down(u: C64) -> bool {
+    if u.im.abs() > 1e-9 * u.re.abs() {
         u.im < 0.0
     } else {
         u.re < 0.0
-    };
-    let w = if flip { -w } else { w };
-    ((w - b) / a, (-w - b) / a, w)
+    }
 }
 
 /// `η² − β²` evaluated as `(η − β)(η + β)`, exact near grazing/critical incidence.
@@ -208,16 +222,14 @@ fn normal_squared(eta: C64, beta: C64) -> C64 {
 }
 
 /// s and p modes of an isotropic medium of index `eta`.
+#[inline(always)]
 pub fn isotropic_modes(eta: C64, beta: C64) -> ModeSet {
     let one = C64::new(1.0, 0.0);
-    let (q_up, q_down) = up_down(
-        one,
-        C64::new(0.0, 0.0),
-        cmath::sqrt(normal_squared(eta, beta)),
-    );
+    let (q_up, q_down) = up_down(cmath::sqrt(normal_squared(eta, beta)));
+    let inv_eta = cmath::inv(eta);
     let pair = |q: C64| {
         let s = Vector3::new(C64::new(0.0, 0.0), one, C64::new(0.0, 0.0));
-        let p = Vector3::new(-q / eta, C64::new(0.0, 0.0), beta / eta);
+        let p = Vector3::new(-q * inv_eta, C64::new(0.0, 0.0), beta * inv_eta);
         [
             Mode::new(ModeKind::S, beta, q, s),
             Mode::new(ModeKind::P, beta, q, p),
@@ -268,51 +280,111 @@ pub fn k_max(medium: &Uniaxial) -> (C64, C64) {
 /// `E = ε⁻¹ D`. If the wave vector is (numerically) along the axis, `k × A` vanishes, o and e
 /// are degenerate and the o-mode falls back to the s direction `ŷ`; the two fields still span
 /// the transverse plane.
+#[inline(always)]
 pub fn uniaxial_modes(medium: &Uniaxial, beta: C64) -> ModeSet {
-    let (qo_up, qo_down) = up_down(
-        C64::new(1.0, 0.0),
-        C64::new(0.0, 0.0),
-        cmath::sqrt(normal_squared(medium.eta_o, beta)),
-    );
+    let (qo_up, qo_down) = up_down(cmath::sqrt(normal_squared(medium.eta_o, beta)));
     let (qe_up, qe_down, w) = extraordinary_q_w(medium, beta);
     let exact_flux = medium.is_lossless() && beta.im == 0.0 && w.im == 0.0;
-    let (eps, eps_inv) = (medium.permittivity(), medium.inverse_permittivity());
-    let pair = |qo: C64, qe: C64, ek_z: f64| {
-        let e_o = normalize(ordinary_displacement(medium, beta, qo));
-        let ke = wave_vector(beta, qe);
-        let d_e = ke.cross(&ordinary_displacement(medium, beta, qe));
-        let e_e = normalize(eps_inv * d_e);
-        let e_mode = if exact_flux {
-            let kek = (ke.transpose() * eps * ke)[(0, 0)].re;
-            Mode::lossless_e(beta, qe, e_e, ek_z, kek)
-        } else {
-            Mode::new(ModeKind::E, beta, qe, e_e)
-        };
-        [Mode::new(ModeKind::O, beta, qo, e_o), e_mode]
-    };
+    let fields = Fields::new(medium, beta);
     ModeSet {
-        down: pair(qo_down, qe_down, -w.re),
-        up: pair(qo_up, qe_up, w.re),
+        down: fields.pair(qo_down, qe_down, exact_flux.then_some(-w.re)),
+        up: fields.pair(qo_up, qe_up, exact_flux.then_some(w.re)),
     }
 }
 
-/// `k × A` for `k = (β, 0, q)`, or `ŷ` when `k` is along the axis (degenerate direction).
-fn ordinary_displacement(medium: &Uniaxial, beta: C64, q: C64) -> C3 {
-    let k = wave_vector(beta, q);
-    let a = medium.axis.map(|x| C64::new(x, 0.0));
-    let c = k.cross(&a);
-    let size = |v: &C3| v.iter().map(|z| z.norm_sqr()).sum::<f64>();
-    if size(&c) > 1e-24 * size(&k) {
-        c
-    } else {
-        Vector3::new(C64::new(0.0, 0.0), C64::new(1.0, 0.0), C64::new(0.0, 0.0))
+/// What the o and e fields of one medium and incidence parameter share: the axis and the
+/// permittivity `ε = ε_o I + Δε A Aᵀ` with its inverse `ε⁻¹ = I/ε_o + Δ(1/ε) A Aᵀ` (seed eq. S6)
+/// as scalars, so that `ε v` and `ε⁻¹ v` cost a dot product with the (real) axis.
+struct Fields {
+    beta: C64,
+    axis: Vector3<f64>,
+    eps_o: C64,
+    delta_eps: C64,
+    inv_o: C64,
+    delta_inv: C64,
+}
+
+impl Fields {
+    #[inline]
+    fn new(medium: &Uniaxial, beta: C64) -> Self {
+        let (eps_o, eps_e) = (medium.eps_o(), medium.eps_e());
+        let (inv_o, inv_e) = (cmath::inv(eps_o), cmath::inv(eps_e));
+        Fields {
+            beta,
+            axis: medium.axis,
+            eps_o,
+            delta_eps: eps_e - eps_o,
+            inv_o,
+            delta_inv: inv_e - inv_o,
+        }
     }
+
+    /// The o and e modes of normal components `qo`, `qe`; `ek_z = Some((εk)_z)` for a lossless
+    /// propagating e-wave (its flux from [`Mode::lossless_e`]).
+    #[inline(always)]
+    fn pair(&self, qo: C64, qe: C64, ek_z: Option<f64>) -> [Mode; 2] {
+        let beta = self.beta;
+        let e_o = normalize(self.ordinary_displacement(qo));
+        let d_e = k_cross(beta, qe, &self.ordinary_displacement(qe));
+        let e_e = normalize(self.inverse_permittivity_times(&d_e));
+        let e_mode = match ek_z {
+            Some(ek_z) => Mode::lossless_e(beta, qe, e_e, ek_z, self.k_eps_k(qe).re),
+            None => Mode::new(ModeKind::E, beta, qe, e_e),
+        };
+        [Mode::new(ModeKind::O, beta, qo, e_o), e_mode]
+    }
+
+    /// `A · v` for the real axis `A`.
+    #[inline]
+    fn axis_dot(&self, v: &C3) -> C64 {
+        let a = &self.axis;
+        v.x * a.x + v.y * a.y + v.z * a.z
+    }
+
+    /// `ε⁻¹ v = v/ε_o + Δ(1/ε) A (A·v)`.
+    #[inline]
+    fn inverse_permittivity_times(&self, v: &C3) -> C3 {
+        let c = self.delta_inv * self.axis_dot(v);
+        let a = &self.axis;
+        Vector3::new(
+            v.x * self.inv_o + c * a.x,
+            v.y * self.inv_o + c * a.y,
+            v.z * self.inv_o + c * a.z,
+        )
+    }
+
+    /// `kᵀ ε k = ε_o (β² + q²) + Δε (A·k)²` for `k = (β, 0, q)`.
+    #[inline]
+    fn k_eps_k(&self, q: C64) -> C64 {
+        let beta = self.beta;
+        let ak = beta * self.axis.x + q * self.axis.z;
+        self.eps_o * (beta * beta + q * q) + self.delta_eps * ak * ak
+    }
+
+    /// `k × A` for `k = (β, 0, q)`, or `ŷ` when `k` is along the axis (degenerate direction).
+    #[inline]
+    fn ordinary_displacement(&self, q: C64) -> C3 {
+        let (beta, a) = (self.beta, &self.axis);
+        let c = Vector3::new(-(q * a.y), q * a.x - beta * a.z, beta * a.y);
+        if size(&c) > 1e-24 * (beta.norm_sqr() + q.norm_sqr()) {
+            c
+        } else {
+            Vector3::new(C64::new(0.0, 0.0), C64::new(1.0, 0.0), C64::new(0.0, 0.0))
+        }
+    }
+}
+
+/// `|v|²`, the squared Hermitian norm.
+#[inline]
+fn size(v: &C3) -> f64 {
+    v.x.norm_sqr() + v.y.norm_sqr() + v.z.norm_sqr()
 }
 
 /// `v / |v|` with the Hermitian norm.
+#[inline]
 fn normalize(v: C3) -> C3 {
-    let n = v.iter().map(|z| z.norm_sqr()).sum::<f64>().sqrt();
-    v * C64::new(1.0 / n, 0.0)
+    let s = 1.0 / size(&v).sqrt();
+    Vector3::new(v.x * s, v.y * s, v.z * s)
 }
 
 /// Wave vector (units of `k0`) of the e-wave whose ray (Poynting) direction is `ray` (unit,

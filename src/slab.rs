@@ -127,13 +127,16 @@ impl Slab {
     pub fn optics(&self, frame: &PlaneFrame, beta: C64) -> Result<SlabOptics> {
         let layer = self.layer.with_axis(frame.to_working(self.layer.axis));
         let inner = modes(&layer, beta);
-        let top = Interface::solve(modes(&self.top, beta), inner)?;
-        let bottom = Interface::solve(inner, modes(&self.bottom, beta))?;
-        Ok(SlabOptics {
-            top,
-            bottom,
+        // Built in place and solved there ([`Interface::solve_in_place`]): the two interfaces
+        // are large, and moving them would cost more than solving them.
+        let mut optics = SlabOptics {
+            top: Interface::unsolved(modes(&self.top, beta), inner),
+            bottom: Interface::unsolved(inner, modes(&self.bottom, beta)),
             thickness_nm: self.thickness_nm,
-        })
+        };
+        optics.top.solve_in_place()?;
+        optics.bottom.solve_in_place()?;
+        Ok(optics)
     }
 }
 
