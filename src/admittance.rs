@@ -6,22 +6,23 @@
 //! `I x_in + O x_out = A_out y_out + A_in y_in`: `I`, `O` are the incoming and outgoing s/p
 //! modes of the isotropic medium (amplitudes `x`), `A_in`, `A_out` those of the other medium
 //! (amplitudes `y`), incoming amplitudes known. An isotropic s mode has only `(E_y, H_x)`, a
-//! p mode only `(E_x, H_y)`, so for each polarisation `k` the linear form
+//! p mode only `(E_x, H_y)`: polarisation `k` of the isotropic medium appears in two rows of
+//! the system only, `E(k)` and `H(k)` (`E(s) = E_y`, `H(s) = H_x`; `E(p) = E_x`, `H(p) = H_y`).
+//! The outgoing wave's admittance `Y_k = h_k^O / e_k^O` turns them into the linear form
 //!
 //! ```text
-//! C_k(ψ) = h_k^O ψ_E(k) − e_k^O ψ_H(k)        (E(s) = E_y, H(s) = H_x; E(p) = E_x, H(p) = H_y)
+//! C_k(ψ) = Y_k ψ_E(k) − ψ_H(k)      (or ψ_E(k) − ψ_H(k)/Y_k when |h_k^O| > |e_k^O|)
 //! ```
-//! (the outgoing wave's admittance `h/e` turned into a row that annihilates it) vanishes on
-//! `O` and is diagonal on `I`: `C(I) = diag(g)`, `g_k = h_k^O e_k^I − e_k^O h_k^I`. Applying `C`
-//! eliminates the unknown isotropic amplitudes `x_out` and leaves the 2x2 system
+//! that vanishes on `O` and is diagonal on `I`: `C(I) = diag(g)`. Applying `C` eliminates the
+//! unknown isotropic amplitudes `x_out` and leaves the 2x2 system
 //!
 //! ```text
 //! L y_out = diag(g) x_in − C(A_in) y_in,      L = C(A_out)
 //! ```
 //! for the outgoing amplitudes of the other medium (both directions of incidence at once:
-//! two right-hand-side blocks). `x_out` follows from one of the two equations of its
-//! polarisation (`E` or `H` row, whichever coefficient of `O` is larger). The 4x4 system is
-//! singular exactly when `L` is (the eliminating transformation is invertible: `e^O_s = 1`).
+//! two right-hand-side blocks). `x_out` follows from the `E(k)` row, or the `H(k)` row when
+//! `|h_k^O| > |e_k^O|` (the same choice: the form's coefficients stay bounded by 1). The
+//! eliminating transformation is invertible, so the 4x4 system is singular exactly when `L` is.
 
 use crate::cmath;
 use num_complex::Complex64 as C64;
@@ -39,16 +40,9 @@ pub struct Solution {
     pub y: [[C64; 4]; 2],
 }
 
-/// The `(E, H)` components of `ψ = (E_x, E_y, H_x, H_y)` matched for polarisation `k`
-/// (0: s, `(E_y, H_x)`; 1: p, `(E_x, H_y)`).
-#[inline(always)]
-fn eh(psi: &[C64; 4], k: usize) -> (C64, C64) {
-    if k == 0 {
-        (psi[1], psi[2])
-    } else {
-        (psi[0], psi[3])
-    }
-}
+/// Indices in `ψ = (E_x, E_y, H_x, H_y)` of the `(E, H)` rows of polarisation `k` (0: s,
+/// `(E_y, H_x)`; 1: p, `(E_x, H_y)`).
+const ROWS: [(usize, usize); 2] = [(1, 2), (0, 3)];
 
 /// Solves the boundary system with the isotropic medium's modes `iso_in`, `iso_out` (`[s, p]`,
 /// tangential `ψ`) and the other medium's `other_in`, `other_out` (any two modes each).
@@ -60,63 +54,101 @@ pub fn solve(
     other_in: &[[C64; 4]; 2],
     other_out: &[[C64; 4]; 2],
 ) -> Option<Solution> {
+    let rows = [Row::new(&iso_out[0], 0), Row::new(&iso_out[1], 1)];
     let zero = C64::new(0.0, 0.0);
     let mut l = [[zero; 2]; 2];
     let mut rhs = [[zero; 4]; 2];
-    for k in 0..2 {
-        let (eo, ho) = eh(&iso_out[k], k);
-        let c = |psi: &[C64; 4]| {
-            let (e, h) = eh(psi, k);
-            ho * e - eo * h
-        };
-        rhs[k][k] = c(&iso_in[k]);
+    for (k, row) in rows.iter().enumerate() {
+        rhs[k][k] = row.form(&iso_in[k]);
         for j in 0..2 {
-            l[k][j] = c(&other_out[j]);
-            rhs[k][2 + j] = -c(&other_in[j]);
+            l[k][j] = row.form(&other_out[j]);
+            rhs[k][2 + j] = -row.form(&other_in[j]);
         }
     }
     let y = solve2(&l, &rhs)?;
     let x = [
-        back_substitute(0, iso_in, iso_out, other_in, other_out, &y),
-        back_substitute(1, iso_in, iso_out, other_in, other_out, &y),
+        rows[0].back_substitute(iso_in, other_in, other_out, &y),
+        rows[1].back_substitute(iso_in, other_in, other_out, &y),
     ];
     Some(Solution { x, y })
 }
 
-/// Row `k` (polarisation) of the isotropic outgoing amplitudes `x_out` for unit incoming
-/// amplitudes `[x_in; y_in]` (columns), given the other medium's outgoing ones `y`: one row
-/// of `I x_in + O x_out = A_out y_out + A_in y_in`, the `E` row or the `H` row of the
-/// polarisation, whichever has the larger coefficient of the outgoing wave.
-#[inline(always)]
-fn back_substitute(
+/// The two rows `E(k)`, `H(k)` of isotropic polarisation `k`, ordered `(lead, second)` so that
+/// the outgoing wave's `lead` component is the larger one: the back-substitution row and the
+/// normalisation of the eliminating form.
+struct Row {
+    /// Index in `ψ` of the lead row.
+    lead: usize,
+    /// Index in `ψ` of the second row.
+    second: usize,
+    /// `1 / lead(O)`.
+    inv: C64,
+    /// `second(O) / lead(O)`: the admittance `Y_k` or its inverse, modulus ≤ 1.
+    ratio: C64,
+    /// The polarisation.
     k: usize,
-    iso_in: &[[C64; 4]; 2],
-    iso_out: &[[C64; 4]; 2],
-    other_in: &[[C64; 4]; 2],
-    other_out: &[[C64; 4]; 2],
-    y: &[[C64; 4]; 2],
-) -> [C64; 4] {
-    let (eo, ho) = eh(&iso_out[k], k);
-    let e_row = eo.norm_sqr() >= ho.norm_sqr();
-    let pick = |psi: &[C64; 4]| {
-        let (e, h) = eh(psi, k);
-        if e_row {
-            e
+}
+
+impl Row {
+    #[inline(always)]
+    fn new(out: &[C64; 4], k: usize) -> Self {
+        let (e, h) = ROWS[k];
+        let (lead, second) = if out[e].norm_sqr() >= out[h].norm_sqr() {
+            (e, h)
         } else {
-            h
+            (h, e)
+        };
+        let inv = cmath::inv(out[lead]);
+        Row {
+            lead,
+            second,
+            inv,
+            ratio: out[second] * inv,
+            k,
         }
-    };
-    let inv = cmath::inv(pick(&iso_out[k]));
-    let (a0, a1) = (pick(&other_out[0]), pick(&other_out[1]));
-    let mut constant = [C64::new(0.0, 0.0); 4];
-    constant[k] = -pick(&iso_in[k]);
-    constant[2] = pick(&other_in[0]);
-    constant[3] = pick(&other_in[1]);
-    let mut x = constant;
-    for (col, v) in x.iter_mut().enumerate() {
-        *v = (a0 * y[0][col] + a1 * y[1][col] + *v) * inv;
     }
-    x
+
+    /// `(lead, second)` components of `ψ`.
+    #[inline(always)]
+    fn split(&self, psi: &[C64; 4]) -> (C64, C64) {
+        (psi[self.lead & 3], psi[self.second & 3])
+    }
+
+    /// The lead component of `ψ` (its back-substitution row).
+    #[inline(always)]
+    fn lead(&self, psi: &[C64; 4]) -> C64 {
+        self.split(psi).0
+    }
+
+    /// Row `k` of the isotropic outgoing amplitudes `x_out` for unit incoming amplitudes
+    /// `[x_in; y_in]` (columns), given the other medium's outgoing ones `y`: the lead row of
+    /// `I x_in + O x_out = A_out y_out + A_in y_in` solved for `x_out,k`.
+    #[inline(always)]
+    fn back_substitute(
+        &self,
+        iso_in: &[[C64; 4]; 2],
+        other_in: &[[C64; 4]; 2],
+        other_out: &[[C64; 4]; 2],
+        y: &[[C64; 4]; 2],
+    ) -> [C64; 4] {
+        let (a0, a1) = (self.lead(&other_out[0]), self.lead(&other_out[1]));
+        let mut x = [C64::new(0.0, 0.0); 4];
+        x[self.k] = -self.lead(&iso_in[self.k]);
+        x[2] = self.lead(&other_in[0]);
+        x[3] = self.lead(&other_in[1]);
+        for (col, v) in x.iter_mut().enumerate() {
+            *v = (a0 * y[0][col] + a1 * y[1][col] + *v) * self.inv;
+        }
+        x
+    }
+
+    /// The eliminating form `C_k(ψ) = ratio · lead(ψ) − second(ψ)` (zero on the outgoing
+    /// wave; up to a sign and scale the `C_k` of the module docs).
+    #[inline(always)]
+    fn form(&self, psi: &[C64; 4]) -> C64 {
+        let (lead, second) = self.split(psi);
+        self.ratio * lead - second
+    }
 }
 
 /// Solves `L X = B` (2x2 `L`, four right-hand sides) by Gaussian elimination with partial
