@@ -24,21 +24,21 @@
 //! `|h_k^O| > |e_k^O|` (the same choice: the form's coefficients stay bounded by 1). The
 //! eliminating transformation is invertible, so the 4x4 system is singular exactly when `L` is.
 
-use crate::cmath;
+use crate::cmath::Scalar;
 use num_complex::Complex64 as C64;
-
-/// A complex 2x2 matrix as rows.
-pub type M2 = [[C64; 2]; 2];
 
 /// Outgoing amplitudes for unit incoming ones: rows are the outgoing waves (two each side),
 /// columns the incoming waves `[x_in s, x_in p, y_in 0, y_in 1]`.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Solution {
+pub struct Solution<T = C64> {
     /// Outgoing waves of the isotropic medium, `[s, p]`.
-    pub x: [[C64; 4]; 2],
+    pub x: [[T; 4]; 2],
     /// Outgoing waves of the other medium.
-    pub y: [[C64; 4]; 2],
+    pub y: [[T; 4]; 2],
 }
+
+/// Tangential fields of a pair of modes.
+type Pair<T> = [[T; 4]; 2];
 
 /// Indices in `ψ = (E_x, E_y, H_x, H_y)` of the `(E, H)` rows of polarisation `k` (0: s,
 /// `(E_y, H_x)`; 1: p, `(E_x, H_y)`).
@@ -47,17 +47,40 @@ const ROWS: [(usize, usize); 2] = [(1, 2), (0, 3)];
 /// Solves the boundary system with the isotropic medium's modes `iso_in`, `iso_out` (`[s, p]`,
 /// tangential `ψ`) and the other medium's `other_in`, `other_out` (any two modes each).
 /// `None` if the reduced system is singular to working precision.
+///
+/// When every field is real (lossless media, propagating waves: the common case) the same
+/// steps run in real arithmetic, which is what the complex ones reduce to then.
 #[inline]
 pub fn solve(
-    iso_in: &[[C64; 4]; 2],
-    iso_out: &[[C64; 4]; 2],
-    other_in: &[[C64; 4]; 2],
-    other_out: &[[C64; 4]; 2],
+    iso_in: &Pair<C64>,
+    iso_out: &Pair<C64>,
+    other_in: &Pair<C64>,
+    other_out: &Pair<C64>,
 ) -> Option<Solution> {
+    let all = [iso_in, iso_out, other_in, other_out];
+    if all.iter().all(|p| p.iter().flatten().all(|z| z.im == 0.0)) {
+        let re = |p: &Pair<C64>| p.map(|m| m.map(|z| z.re));
+        let s = solve_in(&re(iso_in), &re(iso_out), &re(other_in), &re(other_out))?;
+        let c = |p: [[f64; 4]; 2]| p.map(|m| m.map(|x| C64::new(x, 0.0)));
+        return Some(Solution {
+            x: c(s.x),
+            y: c(s.y),
+        });
+    }
+    solve_in(iso_in, iso_out, other_in, other_out)
+}
+
+/// [`solve`] in the arithmetic of `T`.
+#[inline]
+fn solve_in<T: Scalar>(
+    iso_in: &Pair<T>,
+    iso_out: &Pair<T>,
+    other_in: &Pair<T>,
+    other_out: &Pair<T>,
+) -> Option<Solution<T>> {
     let rows = [Row::new(&iso_out[0], 0), Row::new(&iso_out[1], 1)];
-    let zero = C64::new(0.0, 0.0);
-    let mut l = [[zero; 2]; 2];
-    let mut rhs = [[zero; 4]; 2];
+    let mut l = [[T::ZERO; 2]; 2];
+    let mut rhs = [[T::ZERO; 4]; 2];
     for (k, row) in rows.iter().enumerate() {
         rhs[k][k] = row.form(&iso_in[k]);
         for j in 0..2 {
@@ -76,29 +99,29 @@ pub fn solve(
 /// The two rows `E(k)`, `H(k)` of isotropic polarisation `k`, ordered `(lead, second)` so that
 /// the outgoing wave's `lead` component is the larger one: the back-substitution row and the
 /// normalisation of the eliminating form.
-struct Row {
+struct Row<T> {
     /// Index in `ψ` of the lead row.
     lead: usize,
     /// Index in `ψ` of the second row.
     second: usize,
     /// `1 / lead(O)`.
-    inv: C64,
+    inv: T,
     /// `second(O) / lead(O)`: the admittance `Y_k` or its inverse, modulus ≤ 1.
-    ratio: C64,
+    ratio: T,
     /// The polarisation.
     k: usize,
 }
 
-impl Row {
+impl<T: Scalar> Row<T> {
     #[inline(always)]
-    fn new(out: &[C64; 4], k: usize) -> Self {
+    fn new(out: &[T; 4], k: usize) -> Self {
         let (e, h) = ROWS[k];
         let (lead, second) = if out[e].norm_sqr() >= out[h].norm_sqr() {
             (e, h)
         } else {
             (h, e)
         };
-        let inv = cmath::inv(out[lead]);
+        let inv = out[lead].recip();
         Row {
             lead,
             second,
@@ -110,13 +133,13 @@ impl Row {
 
     /// `(lead, second)` components of `ψ`.
     #[inline(always)]
-    fn split(&self, psi: &[C64; 4]) -> (C64, C64) {
+    fn split(&self, psi: &[T; 4]) -> (T, T) {
         (psi[self.lead & 3], psi[self.second & 3])
     }
 
     /// The lead component of `ψ` (its back-substitution row).
     #[inline(always)]
-    fn lead(&self, psi: &[C64; 4]) -> C64 {
+    fn lead(&self, psi: &[T; 4]) -> T {
         self.split(psi).0
     }
 
@@ -126,13 +149,13 @@ impl Row {
     #[inline(always)]
     fn back_substitute(
         &self,
-        iso_in: &[[C64; 4]; 2],
-        other_in: &[[C64; 4]; 2],
-        other_out: &[[C64; 4]; 2],
-        y: &[[C64; 4]; 2],
-    ) -> [C64; 4] {
+        iso_in: &Pair<T>,
+        other_in: &Pair<T>,
+        other_out: &Pair<T>,
+        y: &Pair<T>,
+    ) -> [T; 4] {
         let (a0, a1) = (self.lead(&other_out[0]), self.lead(&other_out[1]));
-        let mut x = [C64::new(0.0, 0.0); 4];
+        let mut x = [T::ZERO; 4];
         x[self.k] = -self.lead(&iso_in[self.k]);
         x[2] = self.lead(&other_in[0]);
         x[3] = self.lead(&other_in[1]);
@@ -145,7 +168,7 @@ impl Row {
     /// The eliminating form `C_k(ψ) = ratio · lead(ψ) − second(ψ)` (zero on the outgoing
     /// wave; up to a sign and scale the `C_k` of the module docs).
     #[inline(always)]
-    fn form(&self, psi: &[C64; 4]) -> C64 {
+    fn form(&self, psi: &[T; 4]) -> T {
         let (lead, second) = self.split(psi);
         self.ratio * lead - second
     }
@@ -155,7 +178,7 @@ impl Row {
 /// pivoting; `None` if `L` is singular to working precision (the criterion of
 /// [`crate::cmath::solve4`]: a pivot below `1e-300` of the largest entry, squared moduli).
 #[inline]
-fn solve2(l: &M2, b: &[[C64; 4]; 2]) -> Option<[[C64; 4]; 2]> {
+fn solve2<T: Scalar>(l: &[[T; 2]; 2], b: &Pair<T>) -> Option<Pair<T>> {
     let scale = l.iter().flatten().map(|z| z.norm_sqr()).fold(0.0, f64::max);
     let (top, bottom) = if l[1][0].norm_sqr() > l[0][0].norm_sqr() {
         (1, 0)
@@ -166,14 +189,14 @@ fn solve2(l: &M2, b: &[[C64; 4]; 2]) -> Option<[[C64; 4]; 2]> {
     if negligible(p0, scale) {
         return None;
     }
-    let inv0 = cmath::inv(p0);
+    let inv0 = p0.recip();
     let m = l[bottom][0] * inv0;
     let p1 = l[bottom][1] - m * l[top][1];
     if negligible(p1, scale) {
         return None;
     }
-    let inv1 = cmath::inv(p1);
-    let mut x = [[C64::new(0.0, 0.0); 4]; 2];
+    let inv1 = p1.recip();
+    let mut x = [[T::ZERO; 4]; 2];
     for col in 0..4 {
         let x1 = (b[bottom][col] - m * b[top][col]) * inv1;
         x[1][col] = x1;
@@ -184,7 +207,7 @@ fn solve2(l: &M2, b: &[[C64; 4]; 2]) -> Option<[[C64; 4]; 2]> {
 
 /// A pivot too small to divide by (or NaN), relative to `scale` (largest squared modulus).
 #[inline]
-fn negligible(pivot: C64, scale: f64) -> bool {
+fn negligible<T: Scalar>(pivot: T, scale: f64) -> bool {
     let n = pivot.norm_sqr();
     n.is_nan() || n <= 1e-300 * scale
 }

@@ -2,6 +2,44 @@
 
 use nalgebra::Matrix4;
 use num_complex::Complex64 as C64;
+use std::ops::{Add, Mul, Neg, Sub};
+
+/// The field of a small dense solve: `f64`, or `C64` when imaginary parts are present (a
+/// system whose entries are all real is solved in real arithmetic, to the same result).
+pub trait Scalar:
+    Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Neg<Output = Self>
+{
+    /// Zero.
+    const ZERO: Self;
+    /// `|z|²`.
+    fn norm_sqr(self) -> f64;
+    /// `1/z` ([`inv`] for complex numbers).
+    fn recip(self) -> Self;
+}
+
+impl Scalar for f64 {
+    const ZERO: Self = 0.0;
+    #[inline(always)]
+    fn norm_sqr(self) -> f64 {
+        self * self
+    }
+    #[inline(always)]
+    fn recip(self) -> Self {
+        1.0 / self
+    }
+}
+
+impl Scalar for C64 {
+    const ZERO: Self = C64::new(0.0, 0.0);
+    #[inline(always)]
+    fn norm_sqr(self) -> f64 {
+        C64::norm_sqr(&self)
+    }
+    #[inline(always)]
+    fn recip(self) -> Self {
+        inv(self)
+    }
+}
 
 /// Principal square root (`Re ≥ 0`, branch cut on the negative real axis, `sqrt(−x ± 0i) =
 /// ±i√x`), by the algebraic formula without trigonometry and without cancellation.
