@@ -81,14 +81,21 @@ impl Interface {
     /// Sets `S` from the mode sets ([`Interface::solve`] without moving `self`).
     #[inline]
     pub(crate) fn solve_in_place(&mut self) -> Result<()> {
-        self.s = if is_sp(&self.upper) {
-            iso_above(&self.upper, &self.lower)?
-        } else if is_sp(&self.lower) {
-            iso_below(&self.upper, &self.lower)?
+        let (upper, lower) = (&self.upper, &self.lower);
+        let iso_above = is_sp(upper);
+        let solution = if iso_above {
+            // Its incoming waves go down, the other medium's go up.
+            let t = [&upper.down, &upper.up, &lower.up, &lower.down].map(tangential);
+            admittance::solve(&t[0], &t[1], &t[2], &t[3])
+        } else if is_sp(lower) {
+            // Its incoming waves go up, the other medium's go down.
+            let t = [&lower.up, &lower.down, &upper.down, &upper.up].map(tangential);
+            admittance::solve(&t[0], &t[1], &t[2], &t[3])
         } else {
-            from_modes_s(&self.upper, &self.lower)?
+            self.s = from_modes_s(upper, lower)?;
+            return Ok(());
         };
-        Ok(())
+        place(&mut self.s, &solution.ok_or_else(singular)?, iso_above)
     }
 
     /// The interface of two isotropic media from its Fresnel amplitudes: every block of `S`
@@ -175,36 +182,6 @@ fn from_modes_s(upper: &ModeSet, lower: &ModeSet) -> Result<Matrix4<C64>> {
     Ok(s)
 }
 
-/// `S` for an isotropic upper medium: its incoming waves go down, the other medium's go up.
-/// Rows `[up₁; down₂]` are the isotropic then the other outgoing waves, columns `[down₁; up₂]`
-/// the isotropic then the other incoming ones: the solution as it comes.
-#[inline]
-fn iso_above(upper: &ModeSet, lower: &ModeSet) -> Result<Matrix4<C64>> {
-    let r = admittance::solve(
-        &tangential(&upper.down),
-        &tangential(&upper.up),
-        &tangential(&lower.up),
-        &tangential(&lower.down),
-    )
-    .ok_or_else(singular)?;
-    assemble([r.x[0], r.x[1], r.y[0], r.y[1]], [0, 1, 2, 3])
-}
-
-/// `S` for an isotropic lower medium: its incoming waves go up, the other medium's go down.
-/// Rows `[up₁; down₂]` are the other then the isotropic outgoing waves, columns `[down₁; up₂]`
-/// the other then the isotropic incoming ones.
-#[inline]
-fn iso_below(upper: &ModeSet, lower: &ModeSet) -> Result<Matrix4<C64>> {
-    let r = admittance::solve(
-        &tangential(&lower.up),
-        &tangential(&lower.down),
-        &tangential(&upper.down),
-        &tangential(&upper.up),
-    )
-    .ok_or_else(singular)?;
-    assemble([r.y[0], r.y[1], r.x[0], r.x[1]], [2, 3, 0, 1])
-}
-
 /// True for the s/p pair of an isotropic medium ([`crate::modes::isotropic_modes`]): the s
 /// mode has only `(E_y, H_x)`, the p mode only `(E_x, H_y)`, which the admittance reduction needs.
 fn is_sp(m: &ModeSet) -> bool {
@@ -218,16 +195,30 @@ fn tangential(pair: &[Mode; 2]) -> [[C64; 4]; 2] {
     [pair[0].tangential(), pair[1].tangential()]
 }
 
-/// The 4x4 scattering matrix from its rows, taking column `j` of `S` from column `cols[j]` of
-/// `rows`; the singular error if any entry is not finite (as [`Interface::from_modes`]).
+/// Writes the admittance solution into `S` (rows `[up₁; down₂]`, columns `[down₁; up₂]`): as
+/// it comes for an isotropic upper medium (its outgoing/incoming waves first), with the
+/// isotropic and the other medium's blocks swapped in rows and columns for an isotropic lower
+/// one. The singular error if any entry is not finite (as [`Interface::from_modes`]).
 #[inline]
-fn assemble(rows: [[C64; 4]; 4], cols: [usize; 4]) -> Result<Matrix4<C64>> {
+fn place(s: &mut Matrix4<C64>, r: &admittance::Solution, iso_above: bool) -> Result<()> {
     // `0·x` is 0 for a finite `x` and NaN otherwise; the sum keeps a NaN.
-    let check: f64 = rows.iter().flatten().map(|z| z.re * 0.0 + z.im * 0.0).sum();
+    let check: f64 = [r.x, r.y]
+        .iter()
+        .flatten()
+        .flatten()
+        .map(|z| z.re * 0.0 + z.im * 0.0)
+        .sum();
     if check != 0.0 {
         return Err(singular());
     }
-    Ok(Matrix4::from_fn(|i, j| rows[i][cols[j]]))
+    let (first, second) = if iso_above { (&r.x, &r.y) } else { (&r.y, &r.x) };
+    let swap = if iso_above { 0 } else { 2 };
+    for (i, row) in first.iter().chain(second.iter()).enumerate() {
+        for (j, z) in row.iter().enumerate() {
+            s[(i, (j + swap) % 4)] = *z;
+        }
+    }
+    Ok(())
 }
 
 /// The power a mode carries through the surface: `|P|`, or 0 if it is evanescent.

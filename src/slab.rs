@@ -127,17 +127,24 @@ impl Slab {
     /// Solves both interfaces for incidence parameter `beta` in the plane of `frame`.
     pub fn optics(&self, frame: &PlaneFrame, beta: C64) -> Result<SlabOptics> {
         let layer = self.layer.with_axis(frame.to_working(self.layer.axis));
+        // Built in the returned value and solved there ([`Interface::solve_in_place`]): the
+        // two interfaces are large, and moving them would cost about as much as solving them.
         let inner = modes(&layer, beta);
-        // Built in place and solved there ([`Interface::solve_in_place`]): the two interfaces
-        // are large, and moving them would cost more than solving them.
-        let mut optics = SlabOptics {
+        let mut out = Ok(SlabOptics {
             top: Interface::unsolved(modes(&self.top, beta), inner),
             bottom: Interface::unsolved(inner, modes(&self.bottom, beta)),
             thickness_nm: self.thickness_nm,
-        };
-        optics.top.solve_in_place()?;
-        optics.bottom.solve_in_place()?;
-        Ok(optics)
+        });
+        if let Ok(optics) = &mut out {
+            if let Err(e) = optics
+                .top
+                .solve_in_place()
+                .and_then(|()| optics.bottom.solve_in_place())
+            {
+                return Err(e);
+            }
+        }
+        out
     }
 }
 
