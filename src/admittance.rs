@@ -59,15 +59,35 @@ pub fn solve(
 ) -> Option<Solution> {
     let all = [iso_in, iso_out, other_in, other_out];
     if all.iter().all(|p| p.iter().flatten().all(|z| z.im == 0.0)) {
-        let re = |p: &Pair<C64>| p.map(|m| m.map(|z| z.re));
-        let s = solve_in(&re(iso_in), &re(iso_out), &re(other_in), &re(other_out))?;
-        let c = |p: [[f64; 4]; 2]| p.map(|m| m.map(|x| C64::new(x, 0.0)));
+        let s = solve_in(
+            &real(iso_in),
+            &real(iso_out),
+            &real(other_in),
+            &real(other_out),
+        )?;
         return Some(Solution {
-            x: c(s.x),
-            y: c(s.y),
+            x: complex(&s.x),
+            y: complex(&s.y),
         });
     }
     solve_in(iso_in, iso_out, other_in, other_out)
+}
+
+/// The real parts.
+#[inline(always)]
+fn real(p: &Pair<C64>) -> Pair<f64> {
+    let r = |m: &[C64; 4]| [m[0].re, m[1].re, m[2].re, m[3].re];
+    [r(&p[0]), r(&p[1])]
+}
+
+/// As complex numbers.
+#[inline(always)]
+fn complex(p: &Pair<f64>) -> Pair<C64> {
+    let c = |m: &[f64; 4]| {
+        let z = |x: f64| C64::new(x, 0.0);
+        [z(m[0]), z(m[1]), z(m[2]), z(m[3])]
+    };
+    [c(&p[0]), c(&p[1])]
 }
 
 /// [`solve`] in the arithmetic of `T`.

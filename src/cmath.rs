@@ -7,30 +7,57 @@ use std::ops::{Add, Mul, Neg, Sub};
 /// The field of a small dense solve: `f64`, or `C64` when imaginary parts are present (a
 /// system whose entries are all real is solved in real arithmetic, to the same result).
 pub trait Scalar:
-    Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Neg<Output = Self>
+    Copy
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Mul<f64, Output = Self>
+    + Neg<Output = Self>
 {
     /// Zero.
     const ZERO: Self;
+    /// One.
+    const ONE: Self;
     /// `|z|²`.
     fn norm_sqr(self) -> f64;
-    /// `1/z` ([`inv`] for complex numbers).
+    /// `1/z` ([`inv`] for complex numbers: `z̄ · (1/|z|²)`, as for real ones).
     fn recip(self) -> Self;
+    /// Complex conjugate.
+    fn conj(self) -> Self;
+    /// Real part.
+    fn re(self) -> f64;
+    /// As a complex number.
+    fn complex(self) -> C64;
 }
 
 impl Scalar for f64 {
     const ZERO: Self = 0.0;
+    const ONE: Self = 1.0;
     #[inline(always)]
     fn norm_sqr(self) -> f64 {
         self * self
     }
     #[inline(always)]
     fn recip(self) -> Self {
-        1.0 / self
+        self * (1.0 / (self * self))
+    }
+    #[inline(always)]
+    fn conj(self) -> Self {
+        self
+    }
+    #[inline(always)]
+    fn re(self) -> f64 {
+        self
+    }
+    #[inline(always)]
+    fn complex(self) -> C64 {
+        C64::new(self, 0.0)
     }
 }
 
 impl Scalar for C64 {
     const ZERO: Self = C64::new(0.0, 0.0);
+    const ONE: Self = C64::new(1.0, 0.0);
     #[inline(always)]
     fn norm_sqr(self) -> f64 {
         C64::norm_sqr(&self)
@@ -38,6 +65,18 @@ impl Scalar for C64 {
     #[inline(always)]
     fn recip(self) -> Self {
         inv(self)
+    }
+    #[inline(always)]
+    fn conj(self) -> Self {
+        C64::conj(&self)
+    }
+    #[inline(always)]
+    fn re(self) -> f64 {
+        self.re
+    }
+    #[inline(always)]
+    fn complex(self) -> C64 {
+        self
     }
 }
 

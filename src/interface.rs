@@ -85,12 +85,14 @@ impl Interface {
         let iso_above = is_sp(upper);
         let solution = if iso_above {
             // Its incoming waves go down, the other medium's go up.
-            let t = [&upper.down, &upper.up, &lower.up, &lower.down].map(tangential);
-            admittance::solve(&t[0], &t[1], &t[2], &t[3])
+            let (iso_in, iso_out) = (tangential(&upper.down), tangential(&upper.up));
+            let (other_in, other_out) = (tangential(&lower.up), tangential(&lower.down));
+            admittance::solve(&iso_in, &iso_out, &other_in, &other_out)
         } else if is_sp(lower) {
             // Its incoming waves go up, the other medium's go down.
-            let t = [&lower.up, &lower.down, &upper.down, &upper.up].map(tangential);
-            admittance::solve(&t[0], &t[1], &t[2], &t[3])
+            let (iso_in, iso_out) = (tangential(&lower.up), tangential(&lower.down));
+            let (other_in, other_out) = (tangential(&upper.down), tangential(&upper.up));
+            admittance::solve(&iso_in, &iso_out, &other_in, &other_out)
         } else {
             self.s = from_modes_s(upper, lower)?;
             return Ok(());
@@ -211,7 +213,11 @@ fn place(s: &mut Matrix4<C64>, r: &admittance::Solution, iso_above: bool) -> Res
     if check != 0.0 {
         return Err(singular());
     }
-    let (first, second) = if iso_above { (&r.x, &r.y) } else { (&r.y, &r.x) };
+    let (first, second) = if iso_above {
+        (&r.x, &r.y)
+    } else {
+        (&r.y, &r.x)
+    };
     let swap = if iso_above { 0 } else { 2 };
     for (i, row) in first.iter().chain(second.iter()).enumerate() {
         for (j, z) in row.iter().enumerate() {

@@ -13,6 +13,7 @@ pub mod dispersion;
 pub mod error;
 pub mod etalon;
 pub mod ffi;
+pub mod fields;
 pub mod frame;
 pub mod fresnel;
 pub mod interface;

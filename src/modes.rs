@@ -7,7 +7,8 @@
 //! `q` the normal component (seed eq. S9). Lengths of wave vectors are in units of `k0`, so
 //! nothing here depends on the wavelength (the seed's "note regarding k").
 
-use crate::cmath;
+use crate::cmath::{self, Scalar};
+use crate::fields::{Fields, Wave};
 use crate::medium::Uniaxial;
 use nalgebra::Vector3;
 use num_complex::Complex64 as C64;
@@ -64,20 +65,6 @@ impl Mode {
             h,
             flux,
         }
-    }
-
-    /// A lossless propagating e-mode whose flux is evaluated without cancellation: its ray is
-    /// `∝ ε k` (seed eq. S12), so `S_z = (S·k) (εk)_z / (kᵀεk)` with `(εk)_z = a q + b = ±w`
-    /// known exactly from the root (near `K_max` the direct `½(E×H*)_z` loses digits).
-    #[inline]
-    fn lossless_e(beta: C64, q: C64, e: C3, ek_z: f64, kek: f64) -> Self {
-        let mut m = Mode::new(ModeKind::E, beta, q, e);
-        // `S·k` with `k = (β, 0, q)` real: only `S_x` and `S_z` of `½ Re(E × H*)` are needed.
-        let (e, h) = (&m.e, &m.h);
-        let s_x = 0.5 * (e.y * h.z.conj() - e.z * h.y.conj()).re;
-        let s_z = 0.5 * (e.x * h.y.conj() - e.y * h.x.conj()).re;
-        m.flux = (s_x * beta.re + s_z * q.re) * ek_z / kek;
-        m
     }
 
     /// The wave vector `(β, 0, q)` in units of `k0`.
@@ -274,117 +261,68 @@ pub fn k_max(medium: &Uniaxial) -> (C64, C64) {
     (medium.eta_o, ke)
 }
 
-/// o and e modes of a (non-isotropic) uniaxial medium (seed eqs. S9-S10).
-///
-/// Fields are built from the displacement: `D_o ∝ k × A`, `D_e ∝ k × (k × A)` (both ⟂ k),
-/// `E = ε⁻¹ D`. If the wave vector is (numerically) along the axis, `k × A` vanishes, o and e
-/// are degenerate and the o-mode falls back to the s direction `ŷ`; the two fields still span
-/// the transverse plane.
+/// o and e modes of a (non-isotropic) uniaxial medium (seed eqs. S9-S10), fields from
+/// [`crate::fields`]: in real arithmetic when every wave vector and field is real (lossless
+/// medium, real `β`, both waves propagating), else in complex arithmetic.
 #[inline(always)]
 pub fn uniaxial_modes(medium: &Uniaxial, beta: C64) -> ModeSet {
-    let (qo_up, qo_down) = up_down(cmath::sqrt(normal_squared(medium.eta_o, beta)));
+    let qo_squared = normal_squared(medium.eta_o, beta);
+    let (qo_up, qo_down) = up_down(cmath::sqrt(qo_squared));
     let (qe_up, qe_down, w) = extraordinary_q_w(medium, beta);
     let exact_flux = medium.is_lossless() && beta.im == 0.0 && w.im == 0.0;
-    let fields = Fields::new(medium, beta);
-    ModeSet {
-        down: fields.pair(qo_down, qe_down, exact_flux.then_some(-w.re)),
-        up: fields.pair(qo_up, qe_up, exact_flux.then_some(w.re)),
+    let q = [qo_down, qe_down, qo_up, qe_up];
+    let ek_z = exact_flux.then_some(w.re);
+    if exact_flux && qo_squared.im == 0.0 && qo_squared.re >= 0.0 {
+        let (eps_o, eps_e) = (medium.eps_o().re, medium.eps_e().re);
+        let fields = Fields::new(eps_o, eps_e, medium.axis, beta.re);
+        let q_re = [q[0].re, q[1].re, q[2].re, q[3].re];
+        uniaxial_pairs(&fields, beta, q_re, q, ek_z)
+    } else {
+        let fields = Fields::new(medium.eps_o(), medium.eps_e(), medium.axis, beta);
+        uniaxial_pairs(&fields, beta, q, q, ek_z)
     }
 }
 
-/// What the o and e fields of one medium and incidence parameter share: the axis and the
-/// permittivity `ε = ε_o I + Δε A Aᵀ` with its inverse `ε⁻¹ = I/ε_o + Δ(1/ε) A Aᵀ` (seed eq. S6)
-/// as scalars, so that `ε v` and `ε⁻¹ v` cost a dot product with the (real) axis.
-struct Fields {
+/// The four modes from `fields` and the normal components `[o↓, e↓, o↑, e↑]` in the arithmetic
+/// of `T` (`q_t`) and as stored (`q`); `w` of the up-going e-wave for exact fluxes.
+#[inline(always)]
+fn uniaxial_pairs<T: Scalar>(
+    fields: &Fields<T>,
     beta: C64,
-    axis: Vector3<f64>,
-    eps_o: C64,
-    delta_eps: C64,
-    inv_o: C64,
-    delta_inv: C64,
-}
-
-impl Fields {
-    #[inline]
-    fn new(medium: &Uniaxial, beta: C64) -> Self {
-        let (eps_o, eps_e) = (medium.eps_o(), medium.eps_e());
-        let (inv_o, inv_e) = (cmath::inv(eps_o), cmath::inv(eps_e));
-        Fields {
-            beta,
-            axis: medium.axis,
-            eps_o,
-            delta_eps: eps_e - eps_o,
-            inv_o,
-            delta_inv: inv_e - inv_o,
-        }
+    q_t: [T; 4],
+    q: [C64; 4],
+    w: Option<f64>,
+) -> ModeSet {
+    let mode = |kind: ModeKind, q: C64, wave: Wave<T>| Mode {
+        kind,
+        beta,
+        q,
+        e: Vector3::new(
+            wave.e[0].complex(),
+            wave.e[1].complex(),
+            wave.e[2].complex(),
+        ),
+        h: Vector3::new(
+            wave.h[0].complex(),
+            wave.h[1].complex(),
+            wave.h[2].complex(),
+        ),
+        flux: wave.flux,
+    };
+    let pair = |i: usize, ek_z: Option<f64>| {
+        [
+            mode(ModeKind::O, q[i], fields.ordinary(q_t[i])),
+            mode(
+                ModeKind::E,
+                q[i + 1],
+                fields.extraordinary(q_t[i + 1], ek_z),
+            ),
+        ]
+    };
+    ModeSet {
+        down: pair(0, w.map(|w| -w)),
+        up: pair(2, w),
     }
-
-    /// The o and e modes of normal components `qo`, `qe`; `ek_z = Some((εk)_z)` for a lossless
-    /// propagating e-wave (its flux from [`Mode::lossless_e`]).
-    #[inline(always)]
-    fn pair(&self, qo: C64, qe: C64, ek_z: Option<f64>) -> [Mode; 2] {
-        let beta = self.beta;
-        let e_o = normalize(self.ordinary_displacement(qo));
-        let d_e = k_cross(beta, qe, &self.ordinary_displacement(qe));
-        let e_e = normalize(self.inverse_permittivity_times(&d_e));
-        let e_mode = match ek_z {
-            Some(ek_z) => Mode::lossless_e(beta, qe, e_e, ek_z, self.k_eps_k(qe).re),
-            None => Mode::new(ModeKind::E, beta, qe, e_e),
-        };
-        [Mode::new(ModeKind::O, beta, qo, e_o), e_mode]
-    }
-
-    /// `A · v` for the real axis `A`.
-    #[inline]
-    fn axis_dot(&self, v: &C3) -> C64 {
-        let a = &self.axis;
-        v.x * a.x + v.y * a.y + v.z * a.z
-    }
-
-    /// `ε⁻¹ v = v/ε_o + Δ(1/ε) A (A·v)`.
-    #[inline]
-    fn inverse_permittivity_times(&self, v: &C3) -> C3 {
-        let c = self.delta_inv * self.axis_dot(v);
-        let a = &self.axis;
-        Vector3::new(
-            v.x * self.inv_o + c * a.x,
-            v.y * self.inv_o + c * a.y,
-            v.z * self.inv_o + c * a.z,
-        )
-    }
-
-    /// `kᵀ ε k = ε_o (β² + q²) + Δε (A·k)²` for `k = (β, 0, q)`.
-    #[inline]
-    fn k_eps_k(&self, q: C64) -> C64 {
-        let beta = self.beta;
-        let ak = beta * self.axis.x + q * self.axis.z;
-        self.eps_o * (beta * beta + q * q) + self.delta_eps * ak * ak
-    }
-
-    /// `k × A` for `k = (β, 0, q)`, or `ŷ` when `k` is along the axis (degenerate direction).
-    #[inline]
-    fn ordinary_displacement(&self, q: C64) -> C3 {
-        let (beta, a) = (self.beta, &self.axis);
-        let c = Vector3::new(-(q * a.y), q * a.x - beta * a.z, beta * a.y);
-        if size(&c) > 1e-24 * (beta.norm_sqr() + q.norm_sqr()) {
-            c
-        } else {
-            Vector3::new(C64::new(0.0, 0.0), C64::new(1.0, 0.0), C64::new(0.0, 0.0))
-        }
-    }
-}
-
-/// `|v|²`, the squared Hermitian norm.
-#[inline]
-fn size(v: &C3) -> f64 {
-    v.x.norm_sqr() + v.y.norm_sqr() + v.z.norm_sqr()
-}
-
-/// `v / |v|` with the Hermitian norm.
-#[inline]
-fn normalize(v: C3) -> C3 {
-    let s = 1.0 / size(&v).sqrt();
-    Vector3::new(v.x * s, v.y * s, v.z * s)
 }
 
 /// Wave vector (units of `k0`) of the e-wave whose ray (Poynting) direction is `ray` (unit,

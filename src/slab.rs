@@ -141,7 +141,7 @@ impl Slab {
                 .solve_in_place()
                 .and_then(|()| optics.bottom.solve_in_place())
             {
-                return Err(e);
+                out = Err(e);
             }
         }
         out
