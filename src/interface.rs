@@ -204,24 +204,23 @@ fn tangential(pair: &[Mode; 2]) -> [[C64; 4]; 2] {
 #[inline]
 fn place(s: &mut Matrix4<C64>, r: &admittance::Solution, iso_above: bool) -> Result<()> {
     // `0·x` is 0 for a finite `x` and NaN otherwise; the sum keeps a NaN.
-    let check: f64 = [r.x, r.y]
-        .iter()
-        .flatten()
-        .flatten()
-        .map(|z| z.re * 0.0 + z.im * 0.0)
-        .sum();
-    if check != 0.0 {
+    let nan = |m: &[[C64; 4]; 2]| {
+        m.iter()
+            .flatten()
+            .fold(0.0, |acc, z| acc + (z.re * 0.0 + z.im * 0.0))
+    };
+    if nan(&r.x) + nan(&r.y) != 0.0 {
         return Err(singular());
     }
-    let (first, second) = if iso_above {
-        (&r.x, &r.y)
+    let (first, second, shift) = if iso_above {
+        (&r.x, &r.y, 0)
     } else {
-        (&r.y, &r.x)
+        (&r.y, &r.x, 2)
     };
-    let swap = if iso_above { 0 } else { 2 };
-    for (i, row) in first.iter().chain(second.iter()).enumerate() {
-        for (j, z) in row.iter().enumerate() {
-            s[(i, (j + swap) % 4)] = *z;
+    for i in 0..2 {
+        for j in 0..4 {
+            s[(i, (j + shift) & 3)] = first[i][j];
+            s[(i + 2, (j + shift) & 3)] = second[i][j];
         }
     }
     Ok(())

@@ -53,20 +53,6 @@ pub struct Mode {
 }
 
 impl Mode {
-    #[inline]
-    fn new(kind: ModeKind, beta: C64, q: C64, e: C3) -> Self {
-        let h = k_cross(beta, q, &e);
-        let flux = 0.5 * (e.x * h.y.conj() - e.y * h.x.conj()).re;
-        Mode {
-            kind,
-            beta,
-            q,
-            e,
-            h,
-            flux,
-        }
-    }
-
     /// The wave vector `(β, 0, q)` in units of `k0`.
     pub fn wave_vector(&self) -> C3 {
         wave_vector(self.beta, self.q)
@@ -143,12 +129,6 @@ pub fn wave_vector(beta: C64, q: C64) -> C3 {
     Vector3::new(beta, C64::new(0.0, 0.0), q)
 }
 
-/// `k × v` for `k = (β, 0, q)` (seed eq. S2 for `v = E`), written out for the zero `k_y`.
-#[inline]
-fn k_cross(beta: C64, q: C64, v: &C3) -> C3 {
-    Vector3::new(-(q * v.y), q * v.x - beta * v.z, beta * v.y)
-}
-
 /// The normal modes of `medium` (its axis given in the working frame) for incidence parameter
 /// `beta` (seed eqs. S9-S10). Isotropic media get s/p modes.
 #[inline(always)]
@@ -208,18 +188,34 @@ fn normal_squared(eta: C64, beta: C64) -> C64 {
     (eta - beta) * (eta + beta)
 }
 
-/// s and p modes of an isotropic medium of index `eta`.
+/// s and p modes of an isotropic medium of index `eta`: `E_s = ŷ`, `H_s = k × ŷ = (−q, 0, β)`,
+/// `E_p = k̂ × ŷ = (−q, 0, β)/η`, `H_p = k × E_p = (0, −(q² + β²)/η, 0)` (written out: the zero
+/// components are exact), fluxes `½ Re(E_x H_y* − E_y H_x*)`.
 #[inline(always)]
 pub fn isotropic_modes(eta: C64, beta: C64) -> ModeSet {
-    let one = C64::new(1.0, 0.0);
+    let zero = C64::new(0.0, 0.0);
     let (q_up, q_down) = up_down(cmath::sqrt(normal_squared(eta, beta)));
     let inv_eta = cmath::inv(eta);
     let pair = |q: C64| {
-        let s = Vector3::new(C64::new(0.0, 0.0), one, C64::new(0.0, 0.0));
-        let p = Vector3::new(-q * inv_eta, C64::new(0.0, 0.0), beta * inv_eta);
+        let (ex, ez) = (-q * inv_eta, beta * inv_eta);
+        let hy = q * ex - beta * ez;
         [
-            Mode::new(ModeKind::S, beta, q, s),
-            Mode::new(ModeKind::P, beta, q, p),
+            Mode {
+                kind: ModeKind::S,
+                beta,
+                q,
+                e: Vector3::new(zero, C64::new(1.0, 0.0), zero),
+                h: Vector3::new(-q, zero, beta),
+                flux: 0.5 * q.re,
+            },
+            Mode {
+                kind: ModeKind::P,
+                beta,
+                q,
+                e: Vector3::new(ex, zero, ez),
+                h: Vector3::new(zero, hy, zero),
+                flux: 0.5 * (ex * hy.conj()).re,
+            },
         ]
     };
     ModeSet {
