@@ -279,6 +279,20 @@ pub fn uniaxial_modes(medium: &Uniaxial, beta: C64) -> ModeSet {
     }
 }
 
+/// A mode from its fields (in the arithmetic of `T`).
+#[inline(always)]
+fn mode<T: Scalar>(kind: ModeKind, beta: C64, q: C64, wave: Wave<T>) -> Mode {
+    let c = |v: &[T; 3]| Vector3::new(v[0].complex(), v[1].complex(), v[2].complex());
+    Mode {
+        kind,
+        beta,
+        q,
+        e: c(&wave.e),
+        h: c(&wave.h),
+        flux: wave.flux,
+    }
+}
+
 /// The four modes from `fields` and the normal components `[o↓, e↓, o↑, e↑]` in the arithmetic
 /// of `T` (`q_t`) and as stored (`q`); `w` of the up-going e-wave for exact fluxes.
 #[inline(always)]
@@ -289,35 +303,16 @@ fn uniaxial_pairs<T: Scalar>(
     q: [C64; 4],
     w: Option<f64>,
 ) -> ModeSet {
-    let mode = |kind: ModeKind, q: C64, wave: Wave<T>| Mode {
-        kind,
-        beta,
-        q,
-        e: Vector3::new(
-            wave.e[0].complex(),
-            wave.e[1].complex(),
-            wave.e[2].complex(),
-        ),
-        h: Vector3::new(
-            wave.h[0].complex(),
-            wave.h[1].complex(),
-            wave.h[2].complex(),
-        ),
-        flux: wave.flux,
-    };
-    let pair = |i: usize, ek_z: Option<f64>| {
-        [
-            mode(ModeKind::O, q[i], fields.ordinary(q_t[i])),
-            mode(
-                ModeKind::E,
-                q[i + 1],
-                fields.extraordinary(q_t[i + 1], ek_z),
-            ),
-        ]
-    };
+    let (o, e) = (ModeKind::O, ModeKind::E);
     ModeSet {
-        down: pair(0, w.map(|w| -w)),
-        up: pair(2, w),
+        down: [
+            mode(o, beta, q[0], fields.ordinary(q_t[0])),
+            mode(e, beta, q[1], fields.extraordinary(q_t[1], w.map(|w| -w))),
+        ],
+        up: [
+            mode(o, beta, q[2], fields.ordinary(q_t[2])),
+            mode(e, beta, q[3], fields.extraordinary(q_t[3], w)),
+        ],
     }
 }
 
