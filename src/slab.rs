@@ -241,7 +241,7 @@ fn propagation(thickness_nm: f64, lambda_nm: f64, q: &[C64; 4]) -> (Matrix2<C64>
 fn phase_factors(thickness_nm: f64, lambda_nm: f64, q: &[C64; 4]) -> ([C64; 2], [C64; 2]) {
     let kd = std::f64::consts::TAU * thickness_nm / lambda_nm;
     let i = C64::new(0.0, 1.0);
-    let p = |k: usize, sign: f64| (i * q[k] * (sign * kd)).exp();
+    let p = |k: usize, sign: f64| expi(i * q[k] * (sign * kd));
     let (down_o, down_e, up_e) = (p(0, -1.0), p(1, -1.0), p(3, 1.0));
     let up_o = if q[2] == -q[0] { down_o } else { p(2, 1.0) };
     ([down_o, down_e], [up_o, up_e])
@@ -262,6 +262,28 @@ fn inverse(m: &Matrix2<C64>) -> Option<Matrix2<C64>> {
         -m[(1, 0)] * r,
         m[(0, 0)] * r,
     ))
+}
+
+/// `exp(z)`; for a purely imaginary `z` (a lossless layer) without the real exponential.
+#[inline(always)]
+fn expi(z: C64) -> C64 {
+    if z.re == 0.0 {
+        let (s, c) = z.im.sin_cos();
+        C64::new(c, s)
+    } else {
+        z.exp()
+    }
+}
+
+/// `a b`, written out.
+#[inline(always)]
+fn mul(a: &Matrix2<C64>, b: &Matrix2<C64>) -> Matrix2<C64> {
+    Matrix2::new(
+        a[(0, 0)] * b[(0, 0)] + a[(0, 1)] * b[(1, 0)],
+        a[(0, 0)] * b[(0, 1)] + a[(0, 1)] * b[(1, 1)],
+        a[(1, 0)] * b[(0, 0)] + a[(1, 1)] * b[(1, 0)],
+        a[(1, 0)] * b[(0, 1)] + a[(1, 1)] * b[(1, 1)],
+    )
 }
 
 /// `diag(a) m`.
@@ -321,17 +343,20 @@ impl SlabBlocks {
         let (pd, pu) = phase_factors(self.thickness_nm, lambda_nm, &self.q);
         // P↑ r₂ P↓, shared by the round trip D and the reflected paths.
         let trip = scale(&pu, &self.r2, &pd);
-        let d = self.r3 * trip;
-        let inner = inverse(&(Matrix2::identity() - d)).ok_or_else(|| {
+        let d = mul(&self.r3, &trip);
+        let inverse = inverse(&(Matrix2::identity() - d)).ok_or_else(|| {
             Error::new(
                 "slab",
                 "internal resonance: the multiple-reflection sum diverges",
             )
-        })? * self.t1;
-        let r = want.reflection.then(|| self.r1 + self.t3 * (trip * inner));
+        })?;
+        let inner = mul(&inverse, &self.t1);
+        let r = want
+            .reflection
+            .then(|| self.r1 + mul(&self.t3, &mul(&trip, &inner)));
         let t = want.transmission.then(|| {
             let f = self.flux.sqrt();
-            self.t2 * scale_rows(&[pd[0] * f, pd[1] * f], &inner)
+            mul(&self.t2, &scale_rows(&[pd[0] * f, pd[1] * f], &inner))
         });
         Ok(SlabJones { r, t })
     }
