@@ -254,4 +254,40 @@ mod tests {
         let s = [[c(1.0, 1.0), c(2.0, 2.0)], [c(0.5, 0.5), c(1.0, 1.0)]];
         assert!(solve2(&s, &b).is_none());
     }
+
+    /// The real arithmetic does exactly what the complex one does on real fields: the same
+    /// operations, and complex products with zero imaginary parts round like real ones.
+    #[test]
+    fn real_arithmetic_equals_complex_arithmetic_on_real_fields() {
+        let mut seed = 12345u64;
+        let mut next = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 4.0 - 2.0
+        };
+        for _ in 0..1000 {
+            let mut pair = |sp: bool| {
+                let mut p = [[0.0; 4]; 2];
+                for (k, m) in p.iter_mut().enumerate() {
+                    for (i, v) in m.iter_mut().enumerate() {
+                        // s/p structure on the isotropic side: s in (E_y, H_x), p in (E_x, H_y).
+                        let used = !sp || (k == 0) == (i == 1 || i == 2);
+                        *v = if used { next() } else { 0.0 };
+                    }
+                }
+                p
+            };
+            let (a, b, c, d) = (pair(true), pair(true), pair(false), pair(false));
+            let real = solve_in(&a, &b, &c, &d).unwrap();
+            let z = |p: &Pair<f64>| complex(p);
+            let full = solve_in(&z(&a), &z(&b), &z(&c), &z(&d)).unwrap();
+            for (r, f) in [(&real.x, &full.x), (&real.y, &full.y)] {
+                for (r, f) in r.iter().flatten().zip(f.iter().flatten()) {
+                    assert_eq!(*r, f.re);
+                    assert_eq!(f.im, 0.0);
+                }
+            }
+        }
+    }
 }

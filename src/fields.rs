@@ -141,3 +141,46 @@ fn normalize<T: Scalar>(v: V3<T>) -> V3<T> {
     let s = 1.0 / size(&v).sqrt();
     [v[0] * s, v[1] * s, v[2] * s]
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use num_complex::Complex64 as C64;
+
+    /// The real arithmetic does exactly what the complex one does on real inputs (same
+    /// operations; complex products with zero imaginary parts round like real ones).
+    #[test]
+    fn real_arithmetic_equals_complex_arithmetic_on_real_inputs() {
+        let mut seed = 777u64;
+        let mut next = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let c = |x: f64| C64::new(x, 0.0);
+        for i in 0..2000 {
+            let axis = match i % 4 {
+                0 => Vector3::z(),
+                _ => Vector3::new(next() - 0.5, next() - 0.5, next() - 0.5).normalize(),
+            };
+            let (eps_o, eps_e) = ((1.2 + 1.8 * next()).powi(2), (1.2 + 1.8 * next()).powi(2));
+            let (beta, q) = (next(), 2.0 * next() - 1.0);
+            let real = Fields::new(eps_o, eps_e, axis, beta);
+            let full = Fields::new(c(eps_o), c(eps_e), axis, c(beta));
+            let ek_z = Some(next());
+            let waves = [
+                (real.ordinary(q), full.ordinary(c(q))),
+                (real.extraordinary(q, ek_z), full.extraordinary(c(q), ek_z)),
+                (real.extraordinary(q, None), full.extraordinary(c(q), None)),
+            ];
+            for (r, f) in waves {
+                assert_eq!(r.flux, f.flux);
+                for (r, f) in r.e.iter().chain(&r.h).zip(f.e.iter().chain(&f.h)) {
+                    assert_eq!(*r, f.re);
+                    assert_eq!(f.im, 0.0);
+                }
+            }
+        }
+    }
+}

@@ -12,6 +12,11 @@
 //! `η_o = η_e` to 1e-9 (its o and e modes of one direction are nearly parallel). They need no
 //! looser bound: the reduction eliminates the isotropic side exactly (its s/p rows are
 //! decoupled), so it adds no conditioning of its own.
+//!
+//! The reduction runs in real arithmetic when every field is real (lossless media, propagating
+//! waves) and in complex arithmetic otherwise; both occur in every family of cases below (the
+//! unit tests of `admittance` and `fields` check that the two arithmetics agree bit for bit on
+//! real inputs).
 
 use birefringent::admittance;
 use birefringent::frame::PlaneFrame;
@@ -117,6 +122,8 @@ struct Tally {
     worst_trap: f64,
     traps: usize,
     evanescent: usize,
+    /// Every field real: the reduction runs in real arithmetic.
+    real: usize,
     singular_both: usize,
 }
 
@@ -162,6 +169,11 @@ fn admittance_path_equals_the_4x4_solve_on_random_interfaces() {
         let err = rel_diff(&fast.s, &full.s);
         let all_modes = m1.up.iter().chain(&m1.down).chain(&m2.up).chain(&m2.down);
         t.evanescent += usize::from(all_modes.clone().any(|m| m.is_evanescent()));
+        t.real += usize::from(
+            all_modes
+                .clone()
+                .all(|m| m.tangential().iter().all(|z| z.im == 0.0)),
+        );
         let case = || {
             format!(
                 "{:?} {:?} beta {} iso above {}",
@@ -181,9 +193,15 @@ fn admittance_path_equals_the_4x4_solve_on_random_interfaces() {
     for (kind, above, t) in &tallies {
         total += t.cases;
         println!(
-            "{kind:30} iso {:5}: {:5} cases ({:4} with an evanescent mode, {:4} grazing/degenerate, {} singular in both), worst {:.2e} (grazing/degenerate {:.2e})",
+            "{kind:30} iso {:5}: {:5} cases ({:4} with an evanescent mode, {:4} all real, {:4} grazing/degenerate, {} singular in both), worst {:.2e} (grazing/degenerate {:.2e})",
             if *above { "above" } else { "below" },
-            t.cases, t.evanescent, t.traps, t.singular_both, t.worst, t.worst_trap
+            t.cases,
+            t.evanescent,
+            t.real,
+            t.traps,
+            t.singular_both,
+            t.worst,
+            t.worst_trap
         );
     }
     println!("worst case (outside the traps): {worst_case}");
@@ -192,6 +210,13 @@ fn admittance_path_equals_the_4x4_solve_on_random_interfaces() {
         assert!(
             t.cases > 1000 && t.evanescent > 50,
             "every family must include evanescent modes"
+        );
+        // Both arithmetics of the reduction (real fields, complex fields) are exercised.
+        assert!(
+            t.real > 100 && t.cases - t.real > 100,
+            "{} real of {}",
+            t.real,
+            t.cases
         );
     }
 }
