@@ -35,7 +35,7 @@ pub enum ModeKind {
 /// Normalisation: s/p modes of isotropic media use the textbook bilinear basis `E_s = ŷ`,
 /// `E_p = k̂ × ŷ` with `k̂ = k/η` (so Fresnel amplitudes are the textbook ones, for complex `η`
 /// too); o/e modes of anisotropic media have unit Hermitian norm `|E| = 1` with the phase of
-/// the closed-form construction below (real for real wave vectors).
+/// the closed-form construction of [`crate::fields`] (real for real wave vectors).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Mode {
     /// Polarisation family.

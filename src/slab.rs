@@ -127,8 +127,8 @@ impl Slab {
     /// Solves both interfaces for incidence parameter `beta` in the plane of `frame`.
     pub fn optics(&self, frame: &PlaneFrame, beta: C64) -> Result<SlabOptics> {
         let layer = self.layer.with_axis(frame.to_working(self.layer.axis));
-        // Built in the returned value and solved there ([`Interface::solve_in_place`]): the
-        // two interfaces are large, and moving them would cost about as much as solving them.
+        // Both interfaces solved where they lie ([`Interface::solve_in_place`]): they are
+        // large, and moving them around costs about as much as solving them.
         let inner = modes(&layer, beta);
         let mut out = Ok(SlabOptics {
             top: Interface::unsolved(modes(&self.top, beta), inner),
