@@ -141,7 +141,7 @@ impl<T: Scalar> Row<T> {
         } else {
             (h, e)
         };
-        let inv = out[lead].recip();
+        let inv = out[lead].inverse();
         Row {
             lead,
             second,
@@ -209,13 +209,13 @@ fn solve2<T: Scalar>(l: &[[T; 2]; 2], b: &Pair<T>) -> Option<Pair<T>> {
     if negligible(p0, scale) {
         return None;
     }
-    let inv0 = p0.recip();
+    let inv0 = p0.inverse();
     let m = l[bottom][0] * inv0;
     let p1 = l[bottom][1] - m * l[top][1];
     if negligible(p1, scale) {
         return None;
     }
-    let inv1 = p1.recip();
+    let inv1 = p1.inverse();
     let mut x = [[T::ZERO; 4]; 2];
     for col in 0..4 {
         let x1 = (b[bottom][col] - m * b[top][col]) * inv1;

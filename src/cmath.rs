@@ -21,7 +21,7 @@ pub trait Scalar:
     /// `|z|²`.
     fn norm_sqr(self) -> f64;
     /// `1/z` ([`inv`] for complex numbers: `z̄ · (1/|z|²)`, as for real ones).
-    fn recip(self) -> Self;
+    fn inverse(self) -> Self;
     /// Complex conjugate.
     fn conj(self) -> Self;
     /// Real part.
@@ -38,7 +38,7 @@ impl Scalar for f64 {
         self * self
     }
     #[inline(always)]
-    fn recip(self) -> Self {
+    fn inverse(self) -> Self {
         self * (1.0 / (self * self))
     }
     #[inline(always)]
@@ -63,7 +63,7 @@ impl Scalar for C64 {
         C64::norm_sqr(&self)
     }
     #[inline(always)]
-    fn recip(self) -> Self {
+    fn inverse(self) -> Self {
         inv(self)
     }
     #[inline(always)]

@@ -40,7 +40,7 @@ impl<T: Scalar> Fields<T> {
     /// The fields of a medium with permittivities `eps_o`, `eps_e` and unit `axis` at `beta`.
     #[inline(always)]
     pub fn new(eps_o: T, eps_e: T, axis: Vector3<f64>, beta: T) -> Self {
-        let (inv_o, inv_e) = (eps_o.recip(), eps_e.recip());
+        let (inv_o, inv_e) = (eps_o.inverse(), eps_e.inverse());
         Fields {
             beta,
             axis,
