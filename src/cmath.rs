@@ -2,6 +2,83 @@
 
 use nalgebra::Matrix4;
 use num_complex::Complex64 as C64;
+use std::ops::{Add, Mul, Neg, Sub};
+
+/// The field of a small dense solve: `f64`, or `C64` when imaginary parts are present (a
+/// system whose entries are all real is solved in real arithmetic, to the same result).
+pub trait Scalar:
+    Copy
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Mul<f64, Output = Self>
+    + Neg<Output = Self>
+{
+    /// Zero.
+    const ZERO: Self;
+    /// One.
+    const ONE: Self;
+    /// `|z|²`.
+    fn norm_sqr(self) -> f64;
+    /// `1/z` ([`inv`] for complex numbers: `z̄ · (1/|z|²)`, as for real ones).
+    fn inverse(self) -> Self;
+    /// Complex conjugate.
+    fn conj(self) -> Self;
+    /// Real part.
+    fn re(self) -> f64;
+    /// As a complex number.
+    fn complex(self) -> C64;
+}
+
+impl Scalar for f64 {
+    const ZERO: Self = 0.0;
+    const ONE: Self = 1.0;
+    #[inline(always)]
+    fn norm_sqr(self) -> f64 {
+        self * self
+    }
+    #[inline(always)]
+    fn inverse(self) -> Self {
+        self * (1.0 / (self * self))
+    }
+    #[inline(always)]
+    fn conj(self) -> Self {
+        self
+    }
+    #[inline(always)]
+    fn re(self) -> f64 {
+        self
+    }
+    #[inline(always)]
+    fn complex(self) -> C64 {
+        C64::new(self, 0.0)
+    }
+}
+
+impl Scalar for C64 {
+    const ZERO: Self = C64::new(0.0, 0.0);
+    const ONE: Self = C64::new(1.0, 0.0);
+    #[inline(always)]
+    fn norm_sqr(self) -> f64 {
+        C64::norm_sqr(&self)
+    }
+    #[inline(always)]
+    fn inverse(self) -> Self {
+        inv(self)
+    }
+    #[inline(always)]
+    fn conj(self) -> Self {
+        C64::conj(&self)
+    }
+    #[inline(always)]
+    fn re(self) -> f64 {
+        self.re
+    }
+    #[inline(always)]
+    fn complex(self) -> C64 {
+        self
+    }
+}
 
 /// Principal square root (`Re ≥ 0`, branch cut on the negative real axis, `sqrt(−x ± 0i) =
 /// ±i√x`), by the algebraic formula without trigonometry and without cancellation.
@@ -22,6 +99,13 @@ pub fn sqrt(z: C64) -> C64 {
         let t = (0.5 * (m - z.re)).sqrt();
         C64::new(z.im.abs() / (2.0 * t), t.copysign(z.im))
     }
+}
+
+/// `1/z` with one real division (`z̄ · (1/|z|²)`); within an ulp or two of `z.inv()`.
+#[inline]
+pub fn inv(z: C64) -> C64 {
+    let r = 1.0 / z.norm_sqr();
+    C64::new(z.re * r, -z.im * r)
 }
 
 /// Solves `A X = B` for a 4×4 complex `A` and 4×4 `B` by Gaussian elimination with partial

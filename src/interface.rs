@@ -6,14 +6,16 @@
 //! Tangential `E` and `H` are continuous across `z = 0`; writing every field as a sum of modes,
 //! `Ψ₁↓ a + Ψ₁↑ b = Ψ₂↓ c + Ψ₂↑ d` with the known incoming amplitudes `a` (from above) and `d`
 //! (from below). Solving `[Ψ₁↑ −Ψ₂↓] [b; c] = [−Ψ₁↓ Ψ₂↑] [a; d]` gives the full scattering
-//! matrix `S` of the interface: `[b; c] = S [a; d]`. This one solve covers iso→aniso,
-//! aniso→iso and aniso→aniso interfaces alike.
+//! matrix `S` of the interface: `[b; c] = S [a; d]`. This one solve ([`Interface::from_modes`])
+//! covers iso→aniso, aniso→iso and aniso→aniso interfaces alike; when one side is isotropic,
+//! [`Interface::solve`] reduces it to a 2x2 solve ([`crate::admittance`]) with the same `S`.
 
+use crate::admittance;
 use crate::cmath;
 use crate::error::{Error, Result};
 use crate::fresnel::Fresnel;
 use crate::medium::Uniaxial;
-use crate::modes::{modes, Mode, ModeSet};
+use crate::modes::{modes, Mode, ModeKind, ModeSet};
 use nalgebra::{Matrix2, Matrix4};
 use num_complex::Complex64 as C64;
 
@@ -42,13 +44,60 @@ impl Interface {
     /// incidence parameter `beta`.
     /// Two isotropic media take the closed-form Fresnel amplitudes ([`Fresnel`]; the same
     /// matrix as the 4x4 solve, which `tests/interface_physics.rs` checks).
+    #[inline]
     pub fn new(upper: &Uniaxial, lower: &Uniaxial, beta: C64) -> Result<Self> {
-        let (m1, m2) = (modes(upper, beta), modes(lower, beta));
         if upper.is_isotropic() && lower.is_isotropic() {
+            let (m1, m2) = (modes(upper, beta), modes(lower, beta));
             let f = Fresnel::new(upper.eta_o, lower.eta_o, beta).ok_or_else(singular)?;
             return Ok(Self::isotropic(m1, m2, &f));
         }
-        Self::from_modes(m1, m2)
+        // Solved in place: an `Interface` is large, moving it costs.
+        let mut out = Self::unsolved(modes(upper, beta), modes(lower, beta));
+        out.solve_in_place()?;
+        Ok(out)
+    }
+
+    /// Solves the boundary system for mode sets as [`modes`] gives them: by the admittance
+    /// reduction ([`crate::admittance`], one 2x2 solve) when either side has s/p modes (an
+    /// isotropic medium), else by the general 4x4 solve ([`Interface::from_modes`]). The same
+    /// scattering matrix either way, to rounding (`tests/interface_fast_path.rs`).
+    #[inline]
+    pub fn solve(upper: ModeSet, lower: ModeSet) -> Result<Self> {
+        let mut out = Self::unsolved(upper, lower);
+        out.solve_in_place()?;
+        Ok(out)
+    }
+
+    /// The two mode sets with `S = 0`, for [`Interface::solve_in_place`].
+    #[inline]
+    pub(crate) fn unsolved(upper: ModeSet, lower: ModeSet) -> Self {
+        Interface {
+            upper,
+            lower,
+            s: Matrix4::zeros(),
+        }
+    }
+
+    /// Sets `S` from the mode sets ([`Interface::solve`] without moving `self`).
+    #[inline]
+    pub(crate) fn solve_in_place(&mut self) -> Result<()> {
+        let (upper, lower) = (&self.upper, &self.lower);
+        let iso_above = is_sp(upper);
+        let solution = if iso_above {
+            // Its incoming waves go down, the other medium's go up.
+            let (iso_in, iso_out) = (tangential(&upper.down), tangential(&upper.up));
+            let (other_in, other_out) = (tangential(&lower.up), tangential(&lower.down));
+            admittance::solve(&iso_in, &iso_out, &other_in, &other_out)
+        } else if is_sp(lower) {
+            // Its incoming waves go up, the other medium's go down.
+            let (iso_in, iso_out) = (tangential(&lower.up), tangential(&lower.down));
+            let (other_in, other_out) = (tangential(&upper.down), tangential(&upper.up));
+            admittance::solve(&iso_in, &iso_out, &other_in, &other_out)
+        } else {
+            self.s = from_modes_s(upper, lower)?;
+            return Ok(());
+        };
+        place(&mut self.s, &solution.ok_or_else(singular)?, iso_above)
     }
 
     /// The interface of two isotropic media from its Fresnel amplitudes: every block of `S`
@@ -66,16 +115,7 @@ impl Interface {
 
     /// Solves the boundary system for given mode sets (seed eq. S18).
     pub fn from_modes(upper: ModeSet, lower: ModeSet) -> Result<Self> {
-        let mut lhs = Matrix4::zeros();
-        let mut rhs = Matrix4::zeros();
-        put(&mut lhs, 0, &upper.up, 1.0);
-        put(&mut lhs, 2, &lower.down, -1.0);
-        put(&mut rhs, 0, &upper.down, -1.0);
-        put(&mut rhs, 2, &lower.up, 1.0);
-        let s = cmath::solve4(&lhs, &rhs).ok_or_else(singular)?;
-        if s.iter().any(|z| !z.re.is_finite() || !z.im.is_finite()) {
-            return Err(singular());
-        }
+        let s = from_modes_s(&upper, &lower)?;
         Ok(Interface { upper, lower, s })
     }
 
@@ -127,6 +167,63 @@ impl Interface {
         let (d, u) = (&self.upper.down, &self.lower.up);
         [&d[0], &d[1], &u[0], &u[1]].map(carried)
     }
+}
+
+/// `S` by the general 4x4 solve of [`Interface::from_modes`].
+fn from_modes_s(upper: &ModeSet, lower: &ModeSet) -> Result<Matrix4<C64>> {
+    let mut lhs = Matrix4::zeros();
+    let mut rhs = Matrix4::zeros();
+    put(&mut lhs, 0, &upper.up, 1.0);
+    put(&mut lhs, 2, &lower.down, -1.0);
+    put(&mut rhs, 0, &upper.down, -1.0);
+    put(&mut rhs, 2, &lower.up, 1.0);
+    let s = cmath::solve4(&lhs, &rhs).ok_or_else(singular)?;
+    if s.iter().any(|z| !z.re.is_finite() || !z.im.is_finite()) {
+        return Err(singular());
+    }
+    Ok(s)
+}
+
+/// True for the s/p pair of an isotropic medium ([`crate::modes::isotropic_modes`]): the s
+/// mode has only `(E_y, H_x)`, the p mode only `(E_x, H_y)`, which the admittance reduction needs.
+fn is_sp(m: &ModeSet) -> bool {
+    let sp = |p: &[Mode; 2]| p[0].kind == ModeKind::S && p[1].kind == ModeKind::P;
+    sp(&m.down) && sp(&m.up)
+}
+
+/// The tangential fields `ψ` of a pair of modes.
+#[inline]
+fn tangential(pair: &[Mode; 2]) -> [[C64; 4]; 2] {
+    [pair[0].tangential(), pair[1].tangential()]
+}
+
+/// Writes the admittance solution into `S` (rows `[up₁; down₂]`, columns `[down₁; up₂]`): as
+/// it comes for an isotropic upper medium (its outgoing/incoming waves first), with the
+/// isotropic and the other medium's blocks swapped in rows and columns for an isotropic lower
+/// one. The singular error if any entry is not finite (as [`Interface::from_modes`]).
+#[inline]
+fn place(s: &mut Matrix4<C64>, r: &admittance::Solution, iso_above: bool) -> Result<()> {
+    // `0·x` is 0 for a finite `x` and NaN otherwise; the sum keeps a NaN.
+    let nan = |m: &[[C64; 4]; 2]| {
+        m.iter()
+            .flatten()
+            .fold(0.0, |acc, z| acc + (z.re * 0.0 + z.im * 0.0))
+    };
+    if nan(&r.x) + nan(&r.y) != 0.0 {
+        return Err(singular());
+    }
+    let (first, second, shift) = if iso_above {
+        (&r.x, &r.y, 0)
+    } else {
+        (&r.y, &r.x, 2)
+    };
+    for i in 0..2 {
+        for j in 0..4 {
+            s[(i, (j + shift) & 3)] = first[i][j];
+            s[(i + 2, (j + shift) & 3)] = second[i][j];
+        }
+    }
+    Ok(())
 }
 
 /// The power a mode carries through the surface: `|P|`, or 0 if it is evanescent.

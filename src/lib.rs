@@ -5,6 +5,7 @@
 //! Everything is computed in `f64`. Time convention: `exp(i (k·r − ω t))`, absorbing indices
 //! `n + iκ` with `κ ≥ 0`.
 
+pub mod admittance;
 pub mod calc;
 pub mod cmath;
 pub mod crystals;
@@ -12,6 +13,7 @@ pub mod dispersion;
 pub mod error;
 pub mod etalon;
 pub mod ffi;
+pub mod fields;
 pub mod frame;
 pub mod fresnel;
 pub mod interface;

@@ -7,7 +7,8 @@
 //! `q` the normal component (seed eq. S9). Lengths of wave vectors are in units of `k0`, so
 //! nothing here depends on the wavelength (the seed's "note regarding k").
 
-use crate::cmath;
+use crate::cmath::{self, Scalar};
+use crate::fields::{Fields, Wave};
 use crate::medium::Uniaxial;
 use nalgebra::Vector3;
 use num_complex::Complex64 as C64;
@@ -34,7 +35,7 @@ pub enum ModeKind {
 /// Normalisation: s/p modes of isotropic media use the textbook bilinear basis `E_s = ŷ`,
 /// `E_p = k̂ × ŷ` with `k̂ = k/η` (so Fresnel amplitudes are the textbook ones, for complex `η`
 /// too); o/e modes of anisotropic media have unit Hermitian norm `|E| = 1` with the phase of
-/// the closed-form construction below (real for real wave vectors).
+/// the closed-form construction of [`crate::fields`] (real for real wave vectors).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Mode {
     /// Polarisation family.
@@ -52,31 +53,6 @@ pub struct Mode {
 }
 
 impl Mode {
-    fn new(kind: ModeKind, beta: C64, q: C64, e: C3) -> Self {
-        let k = wave_vector(beta, q);
-        let h = k.cross(&e);
-        let flux = 0.5 * (e.x * h.y.conj() - e.y * h.x.conj()).re;
-        Mode {
-            kind,
-            beta,
-            q,
-            e,
-            h,
-            flux,
-        }
-    }
-
-    /// A lossless propagating e-mode whose flux is evaluated without cancellation: its ray is
-    /// `∝ ε k` (seed eq. S12), so `S_z = (S·k) (εk)_z / (kᵀεk)` with `(εk)_z = a q + b = ±w`
-    /// known exactly from the root (near `K_max` the direct `½(E×H*)_z` loses digits).
-    fn lossless_e(beta: C64, q: C64, e: C3, ek_z: f64, kek: f64) -> Self {
-        let mut m = Mode::new(ModeKind::E, beta, q, e);
-        let s = m.poynting();
-        let k = Vector3::new(beta.re, 0.0, q.re);
-        m.flux = s.dot(&k) * ek_z / kek;
-        m
-    }
-
     /// The wave vector `(β, 0, q)` in units of `k0`.
     pub fn wave_vector(&self) -> C3 {
         wave_vector(self.beta, self.q)
@@ -155,6 +131,7 @@ pub fn wave_vector(beta: C64, q: C64) -> C3 {
 
 /// The normal modes of `medium` (its axis given in the working frame) for incidence parameter
 /// `beta` (seed eqs. S9-S10). Isotropic media get s/p modes.
+#[inline(always)]
 pub fn modes(medium: &Uniaxial, beta: C64) -> ModeSet {
     if medium.is_isotropic() {
         isotropic_modes(medium.eta_o, beta)
@@ -167,11 +144,7 @@ pub fn modes(medium: &Uniaxial, beta: C64) -> ModeSet {
 /// isotropic medium), without the fields: the same roots and branches as [`modes`], at a
 /// fraction of its cost (for the phases of a layer whose amplitudes are known).
 pub fn normal_components(medium: &Uniaxial, beta: C64) -> [C64; 4] {
-    let (qo_up, qo_down) = up_down(
-        C64::new(1.0, 0.0),
-        C64::new(0.0, 0.0),
-        cmath::sqrt(normal_squared(medium.eta_o, beta)),
-    );
+    let (qo_up, qo_down) = up_down(cmath::sqrt(normal_squared(medium.eta_o, beta)));
     if medium.is_isotropic() {
         return [qo_down, qo_down, qo_up, qo_up];
     }
@@ -179,27 +152,35 @@ pub fn normal_components(medium: &Uniaxial, beta: C64) -> [C64; 4] {
     [qo_down, qe_down, qo_up, qe_up]
 }
 
-/// Picks the root pair `(−b ± w)/a` so that the first returned value is the up-going one.
+/// Picks the root pair `(−b ± w)/a` so that the first returned value is the up-going one,
+/// also returning the `w` of the up-going root (`a q⁺ + b = w`, `a q⁻ + b = −w`).
 ///
 /// A mode goes up if it decays upwards (`Im q > 0`); for (numerically) lossless propagation,
 /// where `Im` carries no information, if its Poynting flux points up, which for both o and e
 /// waves is the sign of `Re(w/a)` (the e-wave ray is `∝ ε k`, whose normal part is `a q + b`).
 /// For passive media both criteria agree wherever both apply.
-fn up_down(a: C64, b: C64, w: C64) -> (C64, C64) {
-    let (up, down, _) = up_down_w(a, b, w);
-    (up, down)
+#[inline]
+fn up_down_w(a: C64, b: C64, w: C64) -> (C64, C64, C64) {
+    let inv_a = cmath::inv(a);
+    let w = if goes_down(w * inv_a) { -w } else { w };
+    ((w - b) * inv_a, (-w - b) * inv_a, w)
 }
 
-/// [`up_down`], also returning the `w` of the up-going root (`a q⁺ + b = w`, `a q⁻ + b = −w`).
-fn up_down_w(a: C64, b: C64, w: C64) -> (C64, C64, C64) {
-    let u = w / a;
-    let flip = if u.im.abs() > 1e-9 * u.re.abs() {
+/// [`up_down_w`] for `a = 1`, `b = 0` (o, s and p waves: `q = ±w`), `(q⁺, q⁻)`.
+#[inline]
+fn up_down(w: C64) -> (C64, C64) {
+    let w = if goes_down(w) { -w } else { w };
+    (w, -w)
+}
+
+/// True if the root `q = u` of `q = ±u` is the down-going one (criterion of [`up_down_w`]).
+#[inline]
+fn goes_down(u: C64) -> bool {
+    if u.im.abs() > 1e-9 * u.re.abs() {
         u.im < 0.0
     } else {
         u.re < 0.0
-    };
-    let w = if flip { -w } else { w };
-    ((w - b) / a, (-w - b) / a, w)
+    }
 }
 
 /// `η² − β²` evaluated as `(η − β)(η + β)`, exact near grazing/critical incidence.
@@ -207,20 +188,34 @@ fn normal_squared(eta: C64, beta: C64) -> C64 {
     (eta - beta) * (eta + beta)
 }
 
-/// s and p modes of an isotropic medium of index `eta`.
+/// s and p modes of an isotropic medium of index `eta`: `E_s = ŷ`, `H_s = k × ŷ = (−q, 0, β)`,
+/// `E_p = k̂ × ŷ = (−q, 0, β)/η`, `H_p = k × E_p = (0, −(q² + β²)/η, 0)` (written out: the zero
+/// components are exact), fluxes `½ Re(E_x H_y* − E_y H_x*)`.
+#[inline(always)]
 pub fn isotropic_modes(eta: C64, beta: C64) -> ModeSet {
-    let one = C64::new(1.0, 0.0);
-    let (q_up, q_down) = up_down(
-        one,
-        C64::new(0.0, 0.0),
-        cmath::sqrt(normal_squared(eta, beta)),
-    );
+    let zero = C64::new(0.0, 0.0);
+    let (q_up, q_down) = up_down(cmath::sqrt(normal_squared(eta, beta)));
+    let inv_eta = cmath::inv(eta);
     let pair = |q: C64| {
-        let s = Vector3::new(C64::new(0.0, 0.0), one, C64::new(0.0, 0.0));
-        let p = Vector3::new(-q / eta, C64::new(0.0, 0.0), beta / eta);
+        let (ex, ez) = (-q * inv_eta, beta * inv_eta);
+        let hy = q * ex - beta * ez;
         [
-            Mode::new(ModeKind::S, beta, q, s),
-            Mode::new(ModeKind::P, beta, q, p),
+            Mode {
+                kind: ModeKind::S,
+                beta,
+                q,
+                e: Vector3::new(zero, C64::new(1.0, 0.0), zero),
+                h: Vector3::new(-q, zero, beta),
+                flux: 0.5 * q.re,
+            },
+            Mode {
+                kind: ModeKind::P,
+                beta,
+                q,
+                e: Vector3::new(ex, zero, ez),
+                h: Vector3::new(zero, hy, zero),
+                flux: 0.5 * (ex * hy.conj()).re,
+            },
         ]
     };
     ModeSet {
@@ -238,15 +233,42 @@ pub fn extraordinary_q(medium: &Uniaxial, beta: C64) -> (C64, C64) {
     (up, down)
 }
 
-/// [`extraordinary_q`] and the up-going `w = a q⁺ + b`.
+/// [`extraordinary_q`] and the up-going `w = a q⁺ + b`. A lossless medium at real `β` has
+/// real coefficients, and real roots unless the e-wave is evanescent: then the same steps run
+/// in real arithmetic (what the complex ones reduce to).
+#[inline]
 fn extraordinary_q_w(medium: &Uniaxial, beta: C64) -> (C64, C64, C64) {
-    let (eo, ee) = (medium.eps_o(), medium.eps_e());
-    let d = ee - eo;
-    let ax = medium.axis;
-    let a = eo + d * ax.z * ax.z;
-    let b = d * beta * ax.x * ax.z;
-    let disc = eo * (ee * a - beta * beta * (ee - d * ax.y * ax.y));
+    if medium.is_lossless() && beta.im == 0.0 {
+        let (eps_o, eps_e) = (medium.eps_o().re, medium.eps_e().re);
+        let (a, b, disc) = extraordinary_coefficients(eps_o, eps_e, &medium.axis, beta.re);
+        let c = |x: f64| C64::new(x, 0.0);
+        if disc >= 0.0 {
+            let w = disc.sqrt();
+            let inv_a = a.inverse();
+            let w = if w * inv_a < 0.0 { -w } else { w };
+            return (c((w - b) * inv_a), c((-w - b) * inv_a), c(w));
+        }
+        return up_down_w(c(a), c(b), cmath::sqrt(c(disc)));
+    }
+    let (a, b, disc) =
+        extraordinary_coefficients(medium.eps_o(), medium.eps_e(), &medium.axis, beta);
     up_down_w(a, b, cmath::sqrt(disc))
+}
+
+/// `(a, b, disc)` of [`extraordinary_q`]: `a q² + 2 b q + c = 0` with the discriminant
+/// `b² − a c = ε_o [ε_e a − β² (ε_e − Δε A_y²)]`.
+#[inline(always)]
+fn extraordinary_coefficients<T: Scalar>(
+    eps_o: T,
+    eps_e: T,
+    axis: &Vector3<f64>,
+    beta: T,
+) -> (T, T, T) {
+    let d = eps_e - eps_o;
+    let a = eps_o + d * axis.z * axis.z;
+    let b = d * beta * axis.x * axis.z;
+    let disc = eps_o * (eps_e * a - beta * beta * (eps_e - d * axis.y * axis.y));
+    (a, b, disc)
 }
 
 /// Maximal incidence parameters `(K_o^max, K_e^max)/k0` beyond which the o and e waves are
@@ -262,57 +284,63 @@ pub fn k_max(medium: &Uniaxial) -> (C64, C64) {
     (medium.eta_o, ke)
 }
 
-/// o and e modes of a (non-isotropic) uniaxial medium (seed eqs. S9-S10).
-///
-/// Fields are built from the displacement: `D_o ∝ k × A`, `D_e ∝ k × (k × A)` (both ⟂ k),
-/// `E = ε⁻¹ D`. If the wave vector is (numerically) along the axis, `k × A` vanishes, o and e
-/// are degenerate and the o-mode falls back to the s direction `ŷ`; the two fields still span
-/// the transverse plane.
+/// o and e modes of a (non-isotropic) uniaxial medium (seed eqs. S9-S10), fields from
+/// [`crate::fields`]: in real arithmetic when every wave vector and field is real (lossless
+/// medium, real `β`, both waves propagating), else in complex arithmetic.
+#[inline(always)]
 pub fn uniaxial_modes(medium: &Uniaxial, beta: C64) -> ModeSet {
-    let (qo_up, qo_down) = up_down(
-        C64::new(1.0, 0.0),
-        C64::new(0.0, 0.0),
-        cmath::sqrt(normal_squared(medium.eta_o, beta)),
-    );
+    let qo_squared = normal_squared(medium.eta_o, beta);
+    let (qo_up, qo_down) = up_down(cmath::sqrt(qo_squared));
     let (qe_up, qe_down, w) = extraordinary_q_w(medium, beta);
     let exact_flux = medium.is_lossless() && beta.im == 0.0 && w.im == 0.0;
-    let (eps, eps_inv) = (medium.permittivity(), medium.inverse_permittivity());
-    let pair = |qo: C64, qe: C64, ek_z: f64| {
-        let e_o = normalize(ordinary_displacement(medium, beta, qo));
-        let ke = wave_vector(beta, qe);
-        let d_e = ke.cross(&ordinary_displacement(medium, beta, qe));
-        let e_e = normalize(eps_inv * d_e);
-        let e_mode = if exact_flux {
-            let kek = (ke.transpose() * eps * ke)[(0, 0)].re;
-            Mode::lossless_e(beta, qe, e_e, ek_z, kek)
-        } else {
-            Mode::new(ModeKind::E, beta, qe, e_e)
-        };
-        [Mode::new(ModeKind::O, beta, qo, e_o), e_mode]
-    };
-    ModeSet {
-        down: pair(qo_down, qe_down, -w.re),
-        up: pair(qo_up, qe_up, w.re),
-    }
-}
-
-/// `k × A` for `k = (β, 0, q)`, or `ŷ` when `k` is along the axis (degenerate direction).
-fn ordinary_displacement(medium: &Uniaxial, beta: C64, q: C64) -> C3 {
-    let k = wave_vector(beta, q);
-    let a = medium.axis.map(|x| C64::new(x, 0.0));
-    let c = k.cross(&a);
-    let size = |v: &C3| v.iter().map(|z| z.norm_sqr()).sum::<f64>();
-    if size(&c) > 1e-24 * size(&k) {
-        c
+    let q = [qo_down, qe_down, qo_up, qe_up];
+    let ek_z = exact_flux.then_some(w.re);
+    if exact_flux && qo_squared.im == 0.0 && qo_squared.re >= 0.0 {
+        let (eps_o, eps_e) = (medium.eps_o().re, medium.eps_e().re);
+        let fields = Fields::new(eps_o, eps_e, medium.axis, beta.re);
+        let q_re = [q[0].re, q[1].re, q[2].re, q[3].re];
+        uniaxial_pairs(&fields, beta, q_re, q, ek_z)
     } else {
-        Vector3::new(C64::new(0.0, 0.0), C64::new(1.0, 0.0), C64::new(0.0, 0.0))
+        let fields = Fields::new(medium.eps_o(), medium.eps_e(), medium.axis, beta);
+        uniaxial_pairs(&fields, beta, q, q, ek_z)
     }
 }
 
-/// `v / |v|` with the Hermitian norm.
-fn normalize(v: C3) -> C3 {
-    let n = v.iter().map(|z| z.norm_sqr()).sum::<f64>().sqrt();
-    v * C64::new(1.0 / n, 0.0)
+/// A mode from its fields (in the arithmetic of `T`).
+#[inline(always)]
+fn mode<T: Scalar>(kind: ModeKind, beta: C64, q: C64, wave: Wave<T>) -> Mode {
+    let c = |v: &[T; 3]| Vector3::new(v[0].complex(), v[1].complex(), v[2].complex());
+    Mode {
+        kind,
+        beta,
+        q,
+        e: c(&wave.e),
+        h: c(&wave.h),
+        flux: wave.flux,
+    }
+}
+
+/// The four modes from `fields` and the normal components `[o↓, e↓, o↑, e↑]` in the arithmetic
+/// of `T` (`q_t`) and as stored (`q`); `w` of the up-going e-wave for exact fluxes.
+#[inline(always)]
+fn uniaxial_pairs<T: Scalar>(
+    fields: &Fields<T>,
+    beta: C64,
+    q_t: [T; 4],
+    q: [C64; 4],
+    w: Option<f64>,
+) -> ModeSet {
+    let (o, e) = (ModeKind::O, ModeKind::E);
+    ModeSet {
+        down: [
+            mode(o, beta, q[0], fields.ordinary(q_t[0])),
+            mode(e, beta, q[1], fields.extraordinary(q_t[1], w.map(|w| -w))),
+        ],
+        up: [
+            mode(o, beta, q[2], fields.ordinary(q_t[2])),
+            mode(e, beta, q[3], fields.extraordinary(q_t[3], w)),
+        ],
+    }
 }
 
 /// Wave vector (units of `k0`) of the e-wave whose ray (Poynting) direction is `ray` (unit,
@@ -338,5 +366,39 @@ pub fn index_along(medium: &Uniaxial, kind: ModeKind, dir: Vector3<f64>) -> C64 
             (medium.eps_o() * medium.eps_e() / dtd).sqrt()
         }
         _ => medium.eta_o,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The real branch of [`extraordinary_q_w`] gives what the complex steps give, bit for bit
+    /// (signs of zero imaginary parts aside), for propagating and evanescent e-waves.
+    #[test]
+    fn real_extraordinary_roots_equal_the_complex_ones() {
+        let mut seed = 99u64;
+        let mut next = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut evanescent = 0;
+        for _ in 0..5000 {
+            let axis = Vector3::new(next() - 0.5, next() - 0.5, next() - 0.5).normalize();
+            let (no, ne) = (1.2 + 1.8 * next(), 1.2 + 1.8 * next());
+            let medium = Uniaxial::new(C64::new(no, 0.0), C64::new(ne, 0.0), axis).unwrap();
+            let beta = C64::new(3.0 * next(), 0.0);
+            let (a, b, disc) =
+                extraordinary_coefficients(medium.eps_o(), medium.eps_e(), &medium.axis, beta);
+            let full = up_down_w(a, b, cmath::sqrt(disc));
+            let fast = extraordinary_q_w(&medium, beta);
+            evanescent += usize::from(full.2.im != 0.0);
+            for (x, y) in [(fast.0, full.0), (fast.1, full.1), (fast.2, full.2)] {
+                assert!(x == y, "{x} vs {y}");
+            }
+        }
+        assert!(evanescent > 500);
     }
 }

@@ -14,6 +14,7 @@
 //! Only decaying exponentials appear (`|exp(−i k0 q↓ d)| ≤ 1`), so thick absorbing or
 //! evanescent layers stay exact: this is a scattering-matrix formulation.
 
+use crate::cmath;
 use crate::error::{Error, Result};
 use crate::frame::PlaneFrame;
 use crate::interface::Interface;
@@ -126,14 +127,24 @@ impl Slab {
     /// Solves both interfaces for incidence parameter `beta` in the plane of `frame`.
     pub fn optics(&self, frame: &PlaneFrame, beta: C64) -> Result<SlabOptics> {
         let layer = self.layer.with_axis(frame.to_working(self.layer.axis));
+        // Both interfaces solved where they lie ([`Interface::solve_in_place`]): they are
+        // large, and moving them around costs about as much as solving them.
         let inner = modes(&layer, beta);
-        let top = Interface::from_modes(modes(&self.top, beta), inner)?;
-        let bottom = Interface::from_modes(inner, modes(&self.bottom, beta))?;
-        Ok(SlabOptics {
-            top,
-            bottom,
+        let mut out = Ok(SlabOptics {
+            top: Interface::unsolved(modes(&self.top, beta), inner),
+            bottom: Interface::unsolved(inner, modes(&self.bottom, beta)),
             thickness_nm: self.thickness_nm,
-        })
+        });
+        if let Ok(optics) = &mut out {
+            if let Err(e) = optics
+                .top
+                .solve_in_place()
+                .and_then(|()| optics.bottom.solve_in_place())
+            {
+                out = Err(e);
+            }
+        }
+        out
     }
 }
 
@@ -217,12 +228,83 @@ impl SlabOptics {
 /// Propagation factors `(P↓, P↑) = (diag exp(−i k0 q↓ d), diag exp(i k0 q↑ d))` of a layer of
 /// thickness `thickness_nm` with normal components `q = [o↓, e↓, o↑, e↑]`.
 fn propagation(thickness_nm: f64, lambda_nm: f64, q: &[C64; 4]) -> (Matrix2<C64>, Matrix2<C64>) {
+    let (pd, pu) = phase_factors(thickness_nm, lambda_nm, q);
+    (
+        Matrix2::from_diagonal(&nalgebra::Vector2::new(pd[0], pd[1])),
+        Matrix2::from_diagonal(&nalgebra::Vector2::new(pu[0], pu[1])),
+    )
+}
+
+/// The diagonals of [`propagation`]. The o-wave's `q↑ = −q↓` (bit for bit, as
+/// [`crate::modes`] builds them) shares one exponential.
+#[inline]
+fn phase_factors(thickness_nm: f64, lambda_nm: f64, q: &[C64; 4]) -> ([C64; 2], [C64; 2]) {
     let kd = std::f64::consts::TAU * thickness_nm / lambda_nm;
     let i = C64::new(0.0, 1.0);
-    let p = |k: usize, sign: f64| (i * q[k] * (sign * kd)).exp();
-    (
-        Matrix2::from_diagonal(&nalgebra::Vector2::new(p(0, -1.0), p(1, -1.0))),
-        Matrix2::from_diagonal(&nalgebra::Vector2::new(p(2, 1.0), p(3, 1.0))),
+    let p = |k: usize, sign: f64| expi(i * q[k] * (sign * kd));
+    let (down_o, down_e, up_e) = (p(0, -1.0), p(1, -1.0), p(3, 1.0));
+    let up_o = if q[2] == -q[0] { down_o } else { p(2, 1.0) };
+    ([down_o, down_e], [up_o, up_e])
+}
+
+/// `m⁻¹` by the adjugate with one division; `None` if the determinant is exactly zero (the
+/// criterion of `nalgebra`'s `try_inverse`, which this replaces on the hot path).
+#[inline]
+fn inverse(m: &Matrix2<C64>) -> Option<Matrix2<C64>> {
+    let det = m[(0, 0)] * m[(1, 1)] - m[(0, 1)] * m[(1, 0)];
+    if det == C64::new(0.0, 0.0) {
+        return None;
+    }
+    let r = cmath::inv(det);
+    Some(Matrix2::new(
+        m[(1, 1)] * r,
+        -m[(0, 1)] * r,
+        -m[(1, 0)] * r,
+        m[(0, 0)] * r,
+    ))
+}
+
+/// `exp(z)`; for a purely imaginary `z` (a lossless layer) without the real exponential.
+#[inline(always)]
+fn expi(z: C64) -> C64 {
+    if z.re == 0.0 {
+        let (s, c) = z.im.sin_cos();
+        C64::new(c, s)
+    } else {
+        z.exp()
+    }
+}
+
+/// `a b`, written out.
+#[inline(always)]
+fn mul(a: &Matrix2<C64>, b: &Matrix2<C64>) -> Matrix2<C64> {
+    Matrix2::new(
+        a[(0, 0)] * b[(0, 0)] + a[(0, 1)] * b[(1, 0)],
+        a[(0, 0)] * b[(0, 1)] + a[(0, 1)] * b[(1, 1)],
+        a[(1, 0)] * b[(0, 0)] + a[(1, 1)] * b[(1, 0)],
+        a[(1, 0)] * b[(0, 1)] + a[(1, 1)] * b[(1, 1)],
+    )
+}
+
+/// `diag(a) m`.
+#[inline]
+fn scale_rows(a: &[C64; 2], m: &Matrix2<C64>) -> Matrix2<C64> {
+    Matrix2::new(
+        a[0] * m[(0, 0)],
+        a[0] * m[(0, 1)],
+        a[1] * m[(1, 0)],
+        a[1] * m[(1, 1)],
+    )
+}
+
+/// `diag(a) m diag(b)`.
+#[inline]
+fn scale(a: &[C64; 2], m: &Matrix2<C64>, b: &[C64; 2]) -> Matrix2<C64> {
+    Matrix2::new(
+        a[0] * m[(0, 0)] * b[0],
+        a[0] * m[(0, 1)] * b[1],
+        a[1] * m[(1, 0)] * b[0],
+        a[1] * m[(1, 1)] * b[1],
     )
 }
 
@@ -258,20 +340,24 @@ pub const BLOCK_VALUES: usize = 29;
 impl SlabBlocks {
     /// The Jones matrices at `lambda_nm` ([`SlabOptics::jones`]).
     pub fn jones(&self, lambda_nm: f64, want: Want) -> Result<SlabJones> {
-        let (pd, pu) = propagation(self.thickness_nm, lambda_nm, &self.q);
-        let d = self.r3 * pu * self.r2 * pd;
-        let inner = (Matrix2::identity() - d).try_inverse().ok_or_else(|| {
+        let (pd, pu) = phase_factors(self.thickness_nm, lambda_nm, &self.q);
+        // P↑ r₂ P↓, shared by the round trip D and the reflected paths.
+        let trip = scale(&pu, &self.r2, &pd);
+        let d = mul(&self.r3, &trip);
+        let inverse = inverse(&(Matrix2::identity() - d)).ok_or_else(|| {
             Error::new(
                 "slab",
                 "internal resonance: the multiple-reflection sum diverges",
             )
-        })? * self.t1;
+        })?;
+        let inner = mul(&inverse, &self.t1);
         let r = want
             .reflection
-            .then(|| self.r1 + self.t3 * pu * self.r2 * pd * inner);
-        let t = want
-            .transmission
-            .then(|| self.t2 * pd * inner * C64::new(self.flux.sqrt(), 0.0));
+            .then(|| self.r1 + mul(&self.t3, &mul(&trip, &inner)));
+        let t = want.transmission.then(|| {
+            let f = self.flux.sqrt();
+            mul(&self.t2, &scale_rows(&[pd[0] * f, pd[1] * f], &inner))
+        });
         Ok(SlabJones { r, t })
     }
 
