@@ -18,7 +18,8 @@
 //! difference of the modes' group paths), and per order `n` of internal round trips an
 //! amplitude of at most `a_n = ρⁿ / (1 − ρ)²` relative to the direct light (`ρ` the spectral
 //! norm of the round-trip matrix; the factor sums the pairs of paths whose orders differ by `n`) at
-//! `ω ≤ n ω₁ + ω_b` (`ω₁` the largest group round trip). The error of a rule on one oscillation
+//! `ω ≤ n ω₁ + ω_b` (`ω₁` the largest group round trip, at the centre and the blue end of
+//! the weights' bulk). The error of a rule on one oscillation
 //! is known exactly: `|Σ_i w_c(k_i) e^{iωk_i} − Σ_j a_j e^{iωμ_j − σ_j²ω²/2}|` (the fitted
 //! weights' Fourier transform is a sum of Gaussians), tabulated per rule over `ω`. The rule
 //! used is the smallest of [`LADDER`] whose error, times each oscillation's amplitude, stays
@@ -239,9 +240,18 @@ fn normal_pdf(k: f64, g: &Gaussian) -> f64 {
 pub fn plan(plate: &Plate, frame: &PlaneFrame, beta: C64, set: WeightSet) -> Result<Option<usize>> {
     let (lo, hi) = support(set);
     // The round trip's norm, its fastest group path and the largest group path difference of
-    // the modes, at the centre and at the short end (where dispersion is steepest).
+    // the modes, at the centre and at the short end of the weights' bulk (`μ + 3σ` of the
+    // bluest Gaussian: dispersion is steepest there; beyond, that Gaussian is below 1.1 % of
+    // its peak, and the dispersion fits of some crystals, extrapolated below their data, grow
+    // without physical meaning towards the support's end; the test against a dense rule of the
+    // exact plate covers the whole support).
+    let bulk = (0..3)
+        .flat_map(|c| gaussians(set, c).iter())
+        .map(|g| g.mu + 3.0 * g.sigma)
+        .fold(0.0, f64::max)
+        .min(hi);
     let (mut rho, mut trip, mut split) = (0.0f64, 0.0f64, 0.0f64);
-    for k in [0.5 * (lo + hi), hi] {
+    for k in [0.5 * (lo + hi), bulk] {
         let optics = plate.at(TAU / k)?.optics(frame, beta)?;
         let (pd, pu) = optics.propagation(TAU / k);
         rho = rho.max(spectral_norm(
