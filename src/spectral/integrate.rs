@@ -427,7 +427,7 @@ fn quadrature_rule(
 ///
 /// A lossless isotropic plate takes its closed form per Gaussian. Otherwise, when the plate's
 /// spectrum varies slowly over the whole visible range (thin plates: few oscillations of its
-/// significant orders across the weights' support), one composite quadrature of the exact plate
+/// significant orders across the weights' support), one product-integration rule of the exact plate
 /// serves every Gaussian of every channel ([`shared`]: at most 1024 plate evaluations instead
 /// of a quadrature per Gaussian). Otherwise each channel goes through [`integrate`].
 pub fn integrate_set(

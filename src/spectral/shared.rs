@@ -9,23 +9,24 @@
 //! `μ_cn = ∫ w_c(k) T_n(t(k)) dk` (computed once, in `θ = arccos t`, where every integrand is
 //! smooth). Each point solves the plate once (its interface blocks interpolated across the
 //! band, [`BlockInterpolant`]) and serves all three channels. Interpolation on Chebyshev points
-//! resolves an oscillation of `Φ` radians across the support with about `Φ/2` points (composite
-//! Gauss–Legendre needs ~4 per radian of `Φ/π`, i.e. twice as many, and more to resolve the
-//! weights' own shape, which the moments here take exactly).
+//! resolves an oscillation of `Φ` radians across the support with about `Φ/2` points, and the
+//! moments take the weights' own shape exactly; a composite Gauss–Legendre rule needs more
+//! nodes for both (at the same tolerance, 1e-7, the random plates of `tests/spectral_shared.rs`
+//! needed 56 Chebyshev points at the median against 256 Gauss–Legendre nodes).
 //!
 //! **How many points.** The plate's spectrum is a sum of oscillations `A(k) e^{iωk}`: the
 //! direct paths' birefringent phase difference (amplitude up to 1, `ω ≤ ω_b`, the largest
 //! difference of the modes' group paths), and per order `n` of internal round trips an
 //! amplitude of at most `a_n = ρⁿ / (1 − ρ)²` relative to the direct light (`ρ` the spectral
-//! norm of the round-trip matrix; the factor sums the pairs of paths whose orders differ by `n`) at
-//! `ω ≤ n ω₁ + ω_b` (`ω₁` the largest group round trip, at the centre and the blue end of
-//! the weights' bulk). The error of a rule on one oscillation
-//! is known exactly: `|Σ_i w_c(k_i) e^{iωk_i} − Σ_j a_j e^{iωμ_j − σ_j²ω²/2}|` (the fitted
-//! weights' Fourier transform is a sum of Gaussians), tabulated per rule over `ω`. The rule
-//! used is the smallest of [`LADDER`] whose error, times each oscillation's amplitude, stays
-//! below [`TOLERANCE`] for every channel (frequencies × [`SPAN_MARGIN`]): low orders, which
-//! carry the light, are resolved to many digits, high orders only as far as their weight needs,
-//! and the weights' shape is in the moments.
+//! norm of the round-trip matrix; the factor sums the pairs of paths whose orders differ by
+//! `n`) at `ω ≤ n ω₁ + ω_b` (`ω₁` the largest group round trip, at the centre and the blue end
+//! of the weights' bulk). The error of a rule on one oscillation is known exactly:
+//! `|Σ_i w_c(k_i) e^{iωk_i} − Σ_j a_j e^{iωμ_j − σ_j²ω²/2}|` (the fitted weights' Fourier
+//! transform is a sum of Gaussians), tabulated per rule over `ω`. The rule used is the
+//! smallest of [`LADDER`] whose error, times each oscillation's amplitude, stays below
+//! [`TOLERANCE`] for every channel (frequencies × [`SPAN_MARGIN`]): low orders, which carry the
+//! light, are resolved to many digits, high orders only as far as their weight needs, and the
+//! weights' shape is in the moments.
 //!
 //! **The points and their weights** depend only on the weight set and the number of points:
 //! they are computed once per (set, rung of [`LADDER`]) and kept, with the rule's error table.
@@ -49,8 +50,8 @@ use std::sync::OnceLock;
 /// and a thousand times below a visible difference (a CIEDE2000 of 1 is ~1e-2 of the signal).
 pub const TOLERANCE: f64 = 1e-5;
 
-/// Margin on the estimated phase span `Φ` (the group round trip is evaluated at the support's
-/// centre and short end; elsewhere it can be larger by a few per cent).
+/// Margin on the estimated frequencies (the group round trip is evaluated at two wavenumbers;
+/// elsewhere it can be larger by a few per cent).
 pub const SPAN_MARGIN: f64 = 1.3;
 
 /// Numbers of Chebyshev points of the rules (at most 1024 plate evaluations).
