@@ -259,13 +259,8 @@ mod tests {
     /// operations, and complex products with zero imaginary parts round like real ones.
     #[test]
     fn real_arithmetic_equals_complex_arithmetic_on_real_fields() {
-        let mut seed = 12345u64;
-        let mut next = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64 * 4.0 - 2.0
-        };
+        let mut uniform = crate::cmath::uniform(12345);
+        let mut next = || 4.0 * uniform() - 2.0;
         for _ in 0..1000 {
             let mut pair = |sp: bool| {
                 let mut p = [[0.0; 4]; 2];

@@ -153,6 +153,19 @@ pub fn solve4(a: &Matrix4<C64>, b: &Matrix4<C64>) -> Option<Matrix4<C64>> {
     Some(Matrix4::from_fn(|i, j| m[i][4 + j]))
 }
 
+/// Uniform numbers in `[0, 1)` from a 64-bit linear congruential generator (Knuth's MMIX
+/// constants, the top 53 bits): reproducible inputs for the unit tests.
+#[cfg(test)]
+pub(crate) fn uniform(seed: u64) -> impl FnMut() -> f64 {
+    let mut state = seed;
+    move || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

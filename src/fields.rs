@@ -151,13 +151,7 @@ mod tests {
     /// operations; complex products with zero imaginary parts round like real ones).
     #[test]
     fn real_arithmetic_equals_complex_arithmetic_on_real_inputs() {
-        let mut seed = 777u64;
-        let mut next = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = crate::cmath::uniform(777);
         let c = |x: f64| C64::new(x, 0.0);
         for i in 0..2000 {
             let axis = match i % 4 {

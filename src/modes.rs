@@ -377,13 +377,7 @@ mod tests {
     /// (signs of zero imaginary parts aside), for propagating and evanescent e-waves.
     #[test]
     fn real_extraordinary_roots_equal_the_complex_ones() {
-        let mut seed = 99u64;
-        let mut next = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = crate::cmath::uniform(99);
         let mut evanescent = 0;
         for _ in 0..5000 {
             let axis = Vector3::new(next() - 0.5, next() - 0.5, next() - 0.5).normalize();

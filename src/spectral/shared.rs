@@ -385,11 +385,8 @@ mod tests {
     /// Against the square root of the largest eigenvalue of `A†A`, on random matrices.
     #[test]
     fn spectral_norm_is_the_largest_singular_value() {
-        let mut x = 0.3f64;
-        let mut next = || {
-            x = (x * 997.0 + 0.123).fract();
-            2.0 * x - 1.0
-        };
+        let mut uniform = crate::cmath::uniform(3);
+        let mut next = || 2.0 * uniform() - 1.0;
         for _ in 0..1000 {
             let a = nalgebra::Matrix2::from_fn(|_, _| C64::new(next(), next()));
             let h = a.adjoint() * a;
