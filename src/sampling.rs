@@ -17,7 +17,9 @@ use crate::material::{check_wavelength, Material};
 use crate::medium::{check_clear_index, Uniaxial};
 use crate::modes::ModeKind;
 use crate::slab::{SlabMueller, Want, THICKNESS_MAX_NM};
-use crate::spectral::integrate::{etalon_sum, integrate, integrate_set, narrow_band, Output};
+use crate::spectral::integrate::{
+    etalon_sum, integrate, integrate_set, is_exact_band, narrow_band, Output,
+};
 use crate::spectral::plate::Plate;
 use crate::spectral::weights::{gaussians, Gaussian, WeightSet};
 use crate::surface::{Incident, Surface};
@@ -133,6 +135,13 @@ pub fn crystal_lobes_full(
     let Some(wi) = checked_direction(wi)? else {
         return Ok(Vec::new());
     };
+    if wi.z < 0.0 && !surface.crystal.is_lossless() {
+        // Light inside an absorbing bulk medium (a metal-like isotropic one: the only kind
+        // accepted) is absorbed over any path of geometric length, and the power fraction of a
+        // wave incident in a lossy medium has no bound (the flux of the incident and reflected
+        // waves' interference is not counted in either): no lobes, in both transport modes.
+        return Ok(Vec::new());
+    }
     let mut lobes = Vec::new();
     for (inc, event) in forward_events(surface, wi)? {
         for (component, mode, l) in outgoing(&event, inc) {
@@ -509,7 +518,7 @@ fn physical_plate(
             .into_iter()
             .map(|(wavelength_nm, fwhm_nm)| {
                 check_bandwidth(fwhm_nm, wavelength_nm)?;
-                if fwhm_nm == 0.0 {
+                if is_exact_band(fwhm_nm, wavelength_nm) {
                     q.plate
                         .mueller_at(wavelength_nm, &frame, beta, want, q.output)
                 } else {
@@ -560,7 +569,7 @@ fn isotropic_plate(
             for (wavelength_nm, fwhm_nm) in spectrum.bands() {
                 check_wavelength(wavelength_nm)?;
                 check_bandwidth(fwhm_nm, wavelength_nm)?;
-                let m = if fwhm_nm == 0.0 {
+                let m = if is_exact_band(fwhm_nm, wavelength_nm) {
                     etalon.mueller(wavelength_nm, q.want, q.output)
                 } else {
                     let g = narrow_band(wavelength_nm, fwhm_nm);

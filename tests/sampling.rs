@@ -215,3 +215,82 @@ fn srgb_lobes_keep_negative_channels() {
     // Same computation through the lobe (scale 1 in reflection): equal to rounding.
     assert!((r - expected).abs() < 1e-12, "lobe R {r} vs {expected}");
 }
+
+/// A metal-like (absorbing isotropic) bulk surface: light arriving from inside gets no lobes in
+/// either transport mode (it cannot cross the absorbing bulk; before, Importance returned lobes
+/// with weights up to 2.07 for 1.5 + 3i, found by the fuzzer), while light from outside is
+/// reflected with its Fresnel reflectance |r|² (closed form for s, checked) and R + T <= 1.
+#[test]
+fn absorbing_bulk_surface_is_opaque_from_inside() {
+    let eta = C64::new(1.5, 3.0);
+    let s = Surface::new(C64::new(1.5, 0.0), Uniaxial::isotropic(eta).unwrap()).unwrap();
+    let mut rng = Rng::new(35);
+    for _ in 0..500 {
+        let wi = rng.unit_vector();
+        if wi.z.abs() < 1e-3 {
+            continue;
+        }
+        for t in [Transport::Radiance, Transport::Importance] {
+            let lobes = crystal_lobes(&s, wi, t).unwrap();
+            if wi.z < 0.0 {
+                assert!(lobes.is_empty(), "{lobes:?} from inside");
+                continue;
+            }
+            let total: f64 = lobes.iter().map(|l| l.weight).sum();
+            let r = lobes.iter().find(|l| l.component == 0).unwrap();
+            // Unpolarised reflectance (|r_s|² + |r_p|²)/2 at incidence cos = wi.z from n = 1.5.
+            let n1 = C64::new(1.5, 0.0);
+            let sin2 = 1.0 - wi.z * wi.z;
+            let c2 = (eta * eta - n1 * n1 * sin2).sqrt() / eta;
+            let c1 = C64::new(wi.z, 0.0);
+            let rs = (n1 * c1 - eta * c2) / (n1 * c1 + eta * c2);
+            let rp = (eta * c1 - n1 * c2) / (eta * c1 + n1 * c2);
+            let expected = 0.5 * (rs.norm_sqr() + rp.norm_sqr());
+            assert!(
+                (r.weight - expected).abs() < 1e-12,
+                "{} vs {expected}",
+                r.weight
+            );
+            if t == Transport::Importance {
+                assert!(total <= 1.0 + 1e-12, "R + T = {total}");
+            }
+        }
+    }
+}
+
+/// A band narrower than `EXACT_BAND` of its wavelength is the exact single-wavelength result;
+/// a subnormal width (5e-324 nm, found by the fuzzer) gave NaN before (its Gaussian's width in
+/// wavenumber underflowed to 0).
+#[test]
+fn vanishing_bandwidth_is_exact() {
+    use birefringent::material::Material;
+    use birefringent::sampling::{plate_lobes, PlateQuery, Spectrum};
+    let q = PlateQuery::new(
+        Material::named("quartz", 0.0, 0.0).unwrap(),
+        0.0,
+        C64::new(1.0, 0.0),
+        C64::new(1.5, 0.0),
+        Vector3::new(1.0, 0.5, 0.3),
+        20_000.0,
+        true,
+        true,
+        false,
+    )
+    .unwrap();
+    let wi = Vector3::new(0.3, 0.2, 0.9).normalize();
+    let band = |fwhm_nm| Spectrum::Band {
+        wavelength_nm: 550.0,
+        fwhm_nm,
+    };
+    let exact = plate_lobes(&q, &band(0.0), wi, Transport::Radiance).unwrap();
+    for tiny in [5e-324, 1e-300, 1e-12] {
+        let got = plate_lobes(&q, &band(tiny), wi, Transport::Radiance).unwrap();
+        assert_eq!(got, exact, "fwhm {tiny}");
+    }
+    // Just above the threshold the band is integrated (and still finite).
+    let above = plate_lobes(&q, &band(1e-6), wi, Transport::Radiance).unwrap();
+    assert!(above[0]
+        .iter()
+        .flatten()
+        .all(|l| l.mueller.iter().all(|x| x.is_finite())));
+}

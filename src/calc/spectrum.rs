@@ -7,7 +7,9 @@ use super::output::num;
 use super::slab::{matrix, read, SlabQuery};
 use crate::error::{Error, Result};
 use crate::slab::{SlabMueller, Want};
-use crate::spectral::integrate::{integrate, integrate_set, narrow_band, quadrature, Output};
+use crate::spectral::integrate::{
+    integrate, integrate_set, is_exact_band, narrow_band, quadrature, Output,
+};
 use crate::spectral::weights::{weight_per_nm, WeightSet};
 use nalgebra::{Matrix4, Vector4};
 use serde_json::{json, Map, Value};
@@ -148,7 +150,7 @@ fn power(m: &Matrix4<f64>, input: f64, output: f64) -> f64 {
 
 /// A Gaussian band of FWHM `b` around the query's wavelength.
 fn band(q: &SlabQuery, b: f64, quad: bool, step: Option<f64>) -> Result<SlabMueller> {
-    if b == 0.0 {
+    if is_exact_band(b, q.wavelength_nm) {
         return q
             .slab
             .optics(&q.frame, q.beta)?

@@ -52,6 +52,17 @@ pub const THICK_ORDER: usize = 2;
 /// Pairs with `σ d |ΔG| > PAIR_CUTOFF` are incoherent (factor < e^{-18} ≈ 1.5e-8).
 pub const PAIR_CUTOFF: f64 = 6.0;
 
+/// Bands narrower than this fraction of their wavelength are the exact single-wavelength result:
+/// across such a band the phase of the thickest accepted plate (1 m, index up to ~3) changes by
+/// less than 1e-4 rad, and its Gaussian's width in wavenumber would underflow for the
+/// subnormal widths a caller could pass.
+pub const EXACT_BAND: f64 = 1e-12;
+
+/// True if a band of FWHM `fwhm_nm` around `center_nm` is treated as exact ([`EXACT_BAND`]).
+pub fn is_exact_band(fwhm_nm: f64, center_nm: f64) -> bool {
+    fwhm_nm <= EXACT_BAND * center_nm
+}
+
 /// A unit-mass Gaussian band of full width at half maximum `fwhm_nm` (in wavelength) around
 /// `center_nm`, expressed in wavenumber.
 pub fn narrow_band(center_nm: f64, fwhm_nm: f64) -> Gaussian {

@@ -159,15 +159,16 @@ pub fn rule(set: WeightSet, points: usize) -> &'static Rule {
         let mu = moments(set);
         let nodes: Vec<(f64, [f64; 3])> = (0..n)
             .map(|j| {
-                let theta = std::f64::consts::PI * (j as f64 + 0.5) / n as f64;
-                let k = 0.5 * (lo + hi) + 0.5 * (hi - lo) * theta.cos();
-                let mut w = [0.0; 3];
-                for (m, moment) in mu.iter().take(n).enumerate() {
-                    let scale = if m == 0 { 1.0 } else { 2.0 } / n as f64;
-                    let t = scale * (m as f64 * theta).cos();
+                let t = (std::f64::consts::PI * (j as f64 + 0.5) / n as f64).cos();
+                let k = 0.5 * (lo + hi) + 0.5 * (hi - lo) * t;
+                // Σ_m (2 − δ_m0)/N T_m(t_j) μ_m, T_m by the recurrence (stable on [−1, 1]).
+                let mut w = mu[0].map(|m0| m0 / n as f64);
+                let (mut previous, mut current) = (1.0, t);
+                for moment in &mu[1..n] {
                     for (wc, mc) in w.iter_mut().zip(moment) {
-                        *wc += t * mc;
+                        *wc += 2.0 / n as f64 * current * mc;
                     }
+                    (previous, current) = (current, 2.0 * t * current - previous);
                 }
                 (k, w)
             })

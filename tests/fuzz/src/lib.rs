@@ -348,7 +348,11 @@ pub fn check_calc_output(sub: &str, text: &str, v: &Value, ok: bool) {
                     Value::Array(a) => stack.extend(a.iter()),
                     Value::Number(n) => {
                         let p = n.as_f64().unwrap_or(f64::NAN);
-                        if !(-1e-9..=1.0 + 1e-9).contains(&p) {
+                        // Rounding bound: at 89.999 deg (cos 1.7e-5) with index contrasts
+                        // of several hundred the boundary systems are conditioned ~1e9-1e10;
+                        // the worst seen, T = 1 + 7.3e-7 (a zero-thickness absorbing layer
+                        // under ext_ior 595), is rounding, not a defect of the method.
+                        if !(-1e-6..=1.0 + 1e-6).contains(&p) {
                             soft_finding(&format!(
                                 "{key} power fraction {p} outside [0, 1] for {sub} {text}"
                             ));
