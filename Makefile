@@ -28,7 +28,7 @@
 #   make bench-scenes  the scene benchmarks alone: the core's shortcuts (examples/bench_shortcuts.rs,
 #                 one core), error vs time per scene, overhead against Mitsuba's own plugins;
 #                 writes bench/results.json, bench/out/ (JSON, PNG plots) and README.md's
-#                 benchmark section (~10 min)
+#                 benchmark section (~4 min)
 
 SHELL := bash
 .SHELLFLAGS := -euo pipefail -c
