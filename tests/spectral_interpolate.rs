@@ -5,7 +5,6 @@ use birefringent::frame::PlaneFrame;
 use birefringent::material::Material;
 use birefringent::slab::Want;
 use birefringent::spectral::interpolate::{BlockInterpolant, TOLERANCE};
-use birefringent::spectral::plate::Plate;
 use birefringent::C64;
 
 mod common;
@@ -20,14 +19,8 @@ fn interpolated_blocks_match_the_exact_plate_across_the_visible() {
     let (lo, hi) = (std::f64::consts::TAU / 830.0, std::f64::consts::TAU / 360.0);
     let (mut worst, mut accepted, mut refused) = (0.0f64, 0, 0);
     for i in 0..200 {
-        let plate = Plate {
-            material: Material::named(names[i % names.len()], 0.0, 0.0).unwrap(),
-            birefringence: 0.0,
-            ext: C64::new(1.0, 0.0),
-            exit: C64::new(rng.range(1.0, 1.6), 0.0),
-            axis: rng.unit_vector(),
-            thickness_nm: 10f64.powf(rng.range(1.0, 4.0)),
-        };
+        let material = Material::named(names[i % names.len()], 0.0, 0.0).unwrap();
+        let plate = common::random_plate(&mut rng, material, (1.0, 1.6), (1.0, 4.0));
         let frame = PlaneFrame::from_azimuth(rng.range(0.0, 6.3));
         let beta = C64::new(rng.range(0.0, 0.95), 0.0);
         let exact = |k: f64| {

@@ -27,14 +27,7 @@ fn random_plate(rng: &mut Rng) -> Plate {
         // Dichroic: absorption differs between o and e.
         _ => Material::constant(C64::new(1.55, 0.0), C64::new(1.56, rng.range(0.0, 2e-4))).unwrap(),
     };
-    Plate {
-        material,
-        birefringence: 0.0,
-        ext: C64::new(1.0, 0.0),
-        exit: C64::new(rng.range(1.0, 1.6), 0.0),
-        axis: rng.unit_vector(),
-        thickness_nm: 10f64.powf(rng.range(2.0, 6.7)),
-    }
+    common::random_plate(rng, material, (1.0, 1.6), (2.0, 6.7))
 }
 
 #[test]

@@ -63,14 +63,7 @@ fn shared_rule_matches_a_dense_rule_of_the_exact_plate() {
         } else {
             Material::named(names[i % names.len()], 0.0, 0.0).unwrap()
         };
-        let plate = Plate {
-            material,
-            birefringence: 0.0,
-            ext: C64::new(1.0, 0.0),
-            exit: C64::new(rng.range(1.0, 1.7), 0.0),
-            axis: rng.unit_vector(),
-            thickness_nm: 10f64.powf(rng.range(1.3, 4.0)),
-        };
+        let plate = common::random_plate(&mut rng, material, (1.0, 1.7), (1.3, 4.0));
         let frame = PlaneFrame::from_azimuth(rng.range(0.0, TAU));
         let beta = C64::new(rng.range(0.0, 0.95), 0.0);
         let set = WeightSet::ALL[i % 3];

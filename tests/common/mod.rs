@@ -53,3 +53,22 @@ impl Rng {
         Vector3::new(r * phi.cos(), r * phi.sin(), z)
     }
 }
+
+/// A plate of `material` below air: exit index uniform in `exit`, a random optic axis and a
+/// thickness of `10^u` nm with `u` uniform in `log10_nm` (drawn in that order).
+pub fn random_plate(
+    rng: &mut Rng,
+    material: birefringent::material::Material,
+    exit: (f64, f64),
+    log10_nm: (f64, f64),
+) -> birefringent::spectral::plate::Plate {
+    use birefringent::C64;
+    birefringent::spectral::plate::Plate {
+        material,
+        birefringence: 0.0,
+        ext: C64::new(1.0, 0.0),
+        exit: C64::new(rng.range(exit.0, exit.1), 0.0),
+        axis: rng.unit_vector(),
+        thickness_nm: 10f64.powf(rng.range(log10_nm.0, log10_nm.1)),
+    }
+}
