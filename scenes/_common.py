@@ -47,6 +47,24 @@ def data_texture(values: np.ndarray, filter_type: str = "bilinear") -> dict:
     }
 
 
+def stressed_plate(index: float, thickness_mm: float, dsigma: np.ndarray, angle: np.ndarray,
+                   stress_optic_per_pa: float, filter_bandwidth: float,
+                   angle_filter: str = "bilinear") -> dict:
+    """A `thinbirefringent` plate of glass (index `index`) under plane stress: n_e - n_o =
+    C (sigma_1 - sigma_2) from the principal stress difference `dsigma` (MPa) with the optic
+    axis along the principal direction `angle` (degrees), both textures over the plate."""
+    return {
+        "type": "thinbirefringent",
+        "eta_o": index,
+        "eta_e": index,
+        "thickness": thickness_mm * 1e3,
+        "birefringence": data_texture(dsigma),
+        "birefringence_scale": stress_optic_per_pa * 1e6,
+        "axis_angle": data_texture(angle, filter_type=angle_filter),
+        "filter_bandwidth": filter_bandwidth,
+    }
+
+
 def monochromatic_srf(wavelength_nm: float, width_nm: float = 0.01) -> dict:
     """A sensor response that is non-zero only within +-width/2 of `wavelength_nm`: spectral
     variants then sample every wavelength of a path inside that band (a monochromatic camera)."""

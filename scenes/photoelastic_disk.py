@@ -39,7 +39,7 @@ import pathlib
 
 import numpy as np
 
-from _common import backlight, data_texture, layer, ortho_sensor
+from _common import backlight, layer, ortho_sensor, stressed_plate
 
 VARIANTS = ("scalar_spectral_polarized",)
 
@@ -126,16 +126,8 @@ def scene(width: int = 512, height: int = 512, spp: int = 16, filter_bandwidth: 
         "light": backlight(-3.0, 4.0),
         "polarizer": layer(-2.0, 2, 2, {"type": "polarizer", "theta": 0.0}),
         "qwp_in": layer(-1.5, 2, 2, {"type": "retarder", "theta": 45.0, "delta": 90.0}),
-        "disk": layer(0.0, 1.0, 1.0, {
-            "type": "thinbirefringent",
-            "eta_o": index,
-            "eta_e": index,
-            "thickness": thickness_mm * 1e3,
-            "birefringence": data_texture(diff),
-            "birefringence_scale": stress_optic_per_pa * 1e6,
-            "axis_angle": data_texture(angle),
-            "filter_bandwidth": filter_bandwidth,
-        }),
+        "disk": layer(0.0, 1.0, 1.0, stressed_plate(index, thickness_mm, diff, angle,
+                                                    stress_optic_per_pa, filter_bandwidth)),
         "qwp_out": layer(1.5, 2, 2, {"type": "retarder", "theta": -45.0, "delta": 90.0}),
         "analyser": layer(2.0, 2, 2, {"type": "polarizer", "theta": 90.0}),
     }

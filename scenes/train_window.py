@@ -39,7 +39,7 @@ import pathlib
 
 import numpy as np
 
-from _common import T, data_texture, layer, ortho_sensor
+from _common import T, layer, ortho_sensor, stressed_plate
 
 VARIANTS = ("scalar_spectral_polarized",)
 
@@ -100,16 +100,9 @@ def scene(width: int = 360, height: int = 240, spp: int = 32, filter_bandwidth: 
         "type": "scene",
         "integrator": {"type": "volpath", "max_depth": 16},
         "sensor": ortho_sensor(width, height, spp, VIEW_X, VIEW_Y),
-        "pane": layer(0.0, VIEW_X, VIEW_Y, {
-            "type": "thinbirefringent",
-            "eta_o": index,
-            "eta_e": index,
-            "thickness": thickness_mm * 1e3,
-            "birefringence": data_texture(diff),
-            "birefringence_scale": stress_optic_per_pa * 1e6,
-            "axis_angle": data_texture(angle, filter_type="nearest"),
-            "filter_bandwidth": filter_bandwidth,
-        }),
+        "pane": layer(0.0, VIEW_X, VIEW_Y, stressed_plate(index, thickness_mm, diff, angle,
+                                                          stress_optic_per_pa, filter_bandwidth,
+                                                          angle_filter="nearest")),
         "water": {
             "type": "rectangle",
             "to_world": T().translate(centre.tolist()).rotate([1, 0, 0], -incidence_deg)

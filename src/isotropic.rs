@@ -75,14 +75,5 @@ fn lobe(
         Transport::Radiance => (wo, 1.0 / (n_ratio * n_ratio)),
     };
     let s = PlaneFrame::from_direction(towards).s;
-    let mueller = m * scale;
-    PathLobe {
-        component,
-        wo,
-        in_stokes_x: s,
-        out_stokes_x: s,
-        mueller,
-        weight: mueller[(0, 0)],
-        eta: n_ratio,
-    }
+    PathLobe::new(component, wo, (s, s), m * scale, n_ratio)
 }

@@ -55,6 +55,27 @@ pub struct PathLobe {
     pub eta: f64,
 }
 
+impl PathLobe {
+    /// A lobe whose weight is its Mueller matrix's `M00`; `stokes_x` = (in, out).
+    pub fn new(
+        component: usize,
+        wo: Vector3<f64>,
+        (in_stokes_x, out_stokes_x): (Vector3<f64>, Vector3<f64>),
+        mueller: Matrix4<f64>,
+        eta: f64,
+    ) -> Self {
+        PathLobe {
+            component,
+            wo,
+            in_stokes_x,
+            out_stokes_x,
+            mueller,
+            weight: mueller[(0, 0)],
+            eta,
+        }
+    }
+}
+
 /// The forward events of light arriving along `−towards` (exterior, or each crystal mode that
 /// can travel there), with the incident crystal mode.
 fn forward_events(
@@ -146,15 +167,13 @@ pub fn crystal_lobes_full(
     for (inc, event) in forward_events(surface, wi)? {
         for (component, mode, l) in outgoing(&event, inc) {
             match transport {
-                Transport::Importance => lobes.push(PathLobe {
+                Transport::Importance => lobes.push(PathLobe::new(
                     component,
-                    wo: l.direction,
-                    in_stokes_x: event.incident_stokes_x,
-                    out_stokes_x: l.stokes_x,
-                    mueller: l.mueller,
-                    weight: l.mueller[(0, 0)],
-                    eta: l.ray_index / event.incident_ray_index,
-                }),
+                    l.direction,
+                    (event.incident_stokes_x, l.stokes_x),
+                    l.mueller,
+                    l.ray_index / event.incident_ray_index,
+                )),
                 Transport::Radiance => {
                     if let Some(p) = radiance_lobe(surface, wi, inc, l.direction, mode)? {
                         lobes.push(p);
@@ -194,16 +213,13 @@ fn radiance_lobe(
         .find(|(_, mode, l)| (l.direction - wi).norm() < 1e-6 && (iso || *mode == wi_mode));
     Ok(found.map(|(component, _, l)| {
         let scale = (l.ray_index / event.incident_ray_index).powi(2);
-        let mueller = l.mueller * scale;
-        PathLobe {
+        PathLobe::new(
             component,
             wo,
-            in_stokes_x: event.incident_stokes_x,
-            out_stokes_x: l.stokes_x,
-            mueller,
-            weight: mueller[(0, 0)],
-            eta: event.incident_ray_index / l.ray_index,
-        }
+            (event.incident_stokes_x, l.stokes_x),
+            l.mueller * scale,
+            event.incident_ray_index / l.ray_index,
+        )
     }))
 }
 
@@ -445,18 +461,11 @@ fn lobes_of_plate(
             if !spectrum.is_signed() {
                 mueller[(0, 0)] = mueller[(0, 0)].max(0.0);
             }
-            out[c][component] = Some(PathLobe {
-                component,
-                wo,
-                in_stokes_x: s,
-                out_stokes_x: s,
-                mueller,
-                weight: mueller[(0, 0)],
-                eta: match transport {
-                    Transport::Radiance => n_in / n_out,
-                    Transport::Importance => n_out / n_in,
-                },
-            });
+            let eta = match transport {
+                Transport::Radiance => n_in / n_out,
+                Transport::Importance => n_out / n_in,
+            };
+            out[c][component] = Some(PathLobe::new(component, wo, (s, s), mueller, eta));
         }
     }
     Ok(out)

@@ -232,24 +232,29 @@ def to_local(frame, v):
     return [u[i] * v[0] + s[i] * v[1] + (v[2] if i == 2 else 0) for i in range(3)]
 
 
+def working_axis(case):
+    """The case's optic axis (any length, local frame) as a unit vector in the working frame of
+    its plane of incidence (`phi_deg`)."""
+    u, s = working_frame(case.get("phi_deg", 0.0))
+    a_local = [mp.mpf(x) for x in case["optic_axis"]]
+    na = mp.sqrt(sum(x * x for x in a_local))
+    a_local = [x / na for x in a_local]
+    return [mp.mpc(sum(a_local[i] * u[i] for i in range(3))),
+            mp.mpc(sum(a_local[i] * s[i] for i in range(3))), mp.mpc(a_local[2])]
+
+
 def interface(case):
     """Reference outputs for one calculator input (a dict with wavelength_nm, ext_ior, eta_o,
     eta_e, optic_axis, beta, phi_deg, side, inside_mode; constant indices only)."""
     n1 = mpc_of(case.get("ext_ior", 1.0))
     eta_o, eta_e = mpc_of(case["eta_o"]), mpc_of(case["eta_e"])
-    frame = working_frame(case.get("phi_deg", 0.0))
-    a_local = [mp.mpf(x) for x in case["optic_axis"]]
-    na = mp.sqrt(sum(x * x for x in a_local))
-    a_local = [x / na for x in a_local]
-    u, s = frame
-    axis = [mp.mpc(sum(a_local[i] * u[i] for i in range(3))),
-            mp.mpc(sum(a_local[i] * s[i] for i in range(3))), mp.mpc(a_local[2])]
+    axis = working_axis(case)
     beta = mpc_of(case["beta"])
     ext_down, ext_up = isotropic_waves(n1, beta)
     cr_down, cr_up = crystal_waves(eta_o, eta_e, axis, beta)
     cols = [w.tangential() for w in ext_up] + [[-x for x in w.tangential()] for w in cr_down]
     out = {"waves_ext_up": ext_up, "waves_cr_down": cr_down, "waves_cr_up": cr_up,
-           "waves_ext_down": ext_down, "frame": frame}
+           "waves_ext_down": ext_down, "frame": working_frame(case.get("phi_deg", 0.0))}
     if case.get("side", "outside") == "outside":
         R, T, r, t = {}, {}, {}, {}
         for a, inc in zip("sp", ext_down):
@@ -320,13 +325,7 @@ def slab(case):
     n1 = mpc_of(case.get("ext_ior", 1.0))
     n3 = mpc_of(case.get("exit_ior", case.get("ext_ior", 1.0)))
     eta_o, eta_e = mpc_of(case["eta_o"]), mpc_of(case["eta_e"])
-    frame = working_frame(case.get("phi_deg", 0.0))
-    a_local = [mp.mpf(x) for x in case["optic_axis"]]
-    na = mp.sqrt(sum(x * x for x in a_local))
-    a_local = [x / na for x in a_local]
-    u, s = frame
-    axis = [mp.mpc(sum(a_local[i] * u[i] for i in range(3))),
-            mp.mpc(sum(a_local[i] * s[i] for i in range(3))), mp.mpc(a_local[2])]
+    axis = working_axis(case)
     beta = mpc_of(case["beta"])
     k0d = 2 * mp.pi * mp.mpf(case["thickness_um"]) * 1000 / mp.mpf(case["wavelength_nm"])
     top_down, top_up = isotropic_waves(n1, beta)
