@@ -229,6 +229,20 @@ fn check_lobes(
 }
 
 /// What a successful call must satisfy (see the contract at the top).
+impl Expect {
+    /// A plate entry point writing `n_out` lobes (components 0 and 1).
+    fn plate(n_out: usize, intensity_only: bool, rgb: bool, importance_plate: bool) -> Self {
+        Expect {
+            n_out,
+            max_component: 1,
+            intensity_only,
+            rgb,
+            importance_plate,
+            crystal_importance: false,
+        }
+    }
+}
+
 struct Expect {
     /// Lobes the call writes to `out`.
     n_out: usize,
@@ -423,14 +437,7 @@ fuzz_target!(|data: &[u8]| {
             call(
                 &mut b,
                 &a,
-                Expect {
-                    n_out: 2,
-                    max_component: 1,
-                    intensity_only,
-                    rgb: false,
-                    importance_plate: importance,
-                    crystal_importance: false,
-                },
+                Expect::plate(2, intensity_only, false, importance),
                 |out, mp_, ml| {
                     // SAFETY: out holds 2 lobes or is null.
                     unsafe {
@@ -456,14 +463,7 @@ fuzz_target!(|data: &[u8]| {
             call(
                 &mut b,
                 &a,
-                Expect {
-                    n_out: 2 * count.max(1),
-                    max_component: 1,
-                    intensity_only,
-                    rgb: false,
-                    importance_plate: importance,
-                    crystal_importance: false,
-                },
+                Expect::plate(2 * count.max(1), intensity_only, false, importance),
                 |out, mp_, ml| {
                     // SAFETY: out holds 2 x max(count, 1) lobes or is null; wv holds
                     // max(count, 1) values or is null.
@@ -479,14 +479,7 @@ fuzz_target!(|data: &[u8]| {
             call(
                 &mut b,
                 &args("sRGB channels".into()),
-                Expect {
-                    n_out: 6,
-                    max_component: 1,
-                    intensity_only,
-                    rgb: true,
-                    importance_plate: false,
-                    crystal_importance: false,
-                },
+                Expect::plate(6, intensity_only, true, false),
                 |out, mp_, ml| {
                     // SAFETY: out holds 3 x 2 lobes or is null.
                     unsafe { bfr_plate_lobes_rgb(mp, gp, wp, transport, flags, out, mp_, ml) }

@@ -435,3 +435,17 @@ pub fn known_calc(text: &str) -> bool {
     }
     false
 }
+
+/// Runs calculator subcommand `sub` on document `text` and checks its output (the calculator
+/// targets' common step): `FUZZ_PRINT=1 TARGET FILE` says what is run; [`known_calc`] inputs
+/// are skipped.
+pub fn run_calc(sub: &str, text: &str) {
+    if std::env::var_os("FUZZ_PRINT").is_some() {
+        eprintln!("{sub} {text}");
+    }
+    if known_calc(text) {
+        return;
+    }
+    let (v, ok) = birefringent::calc::run_text(sub, text);
+    check_calc_output(sub, text, &v, ok);
+}
