@@ -258,18 +258,6 @@ pub fn etalon_sum(
     output: Output,
     incoherent: &mut Option<SlabMueller>,
 ) -> Option<SlabMueller> {
-    if band.iter().all(|g| etalon.is_incoherent(g)) {
-        // A thick plate: the same incoherent sum for every Gaussian (computed once).
-        let m = match incoherent {
-            Some(m) => *m,
-            None => *incoherent.insert(etalon.band(&band[0], want, output)?),
-        };
-        let weight: f64 = band.iter().map(|g| g.amplitude).sum();
-        return Some(SlabMueller {
-            r: m.r.map(|r| r * weight),
-            t: m.t.map(|t| t * weight),
-        });
-    }
     let (mut r, mut t) = (Matrix4::zeros(), Matrix4::zeros());
     let mut weight = 0.0; // of the incoherent Gaussians
     for g in band {
