@@ -192,9 +192,10 @@ def generate(n, seed=6):
     return cases
 
 
-def run_core(cases):
+def run_core(cases, sub="interface"):
+    """The calculator's answers to `cases` ((category, case) pairs), one batch run of `sub`."""
     text = "\n".join(json.dumps(c) for _, c in cases) + "\n"
-    p = subprocess.run([BIN, "interface", "--batch"], input=text, capture_output=True, text=True)
+    p = subprocess.run([BIN, sub, "--batch"], input=text, capture_output=True, text=True)
     return [json.loads(line) for line in p.stdout.splitlines()]
 
 
@@ -381,12 +382,6 @@ def generate_slabs(n, seed=7):
     return cases
 
 
-def run_core_slab(cases):
-    text = "\n".join(json.dumps(c) for _, c in cases) + "\n"
-    p = subprocess.run([BIN, "slab", "--batch"], input=text, capture_output=True, text=True)
-    return [json.loads(line) for line in p.stdout.splitlines()]
-
-
 def compare_slab(category, case, core, errors, details):
     out = ref.slab(case)
     beta = case["beta"]
@@ -416,7 +411,7 @@ def compare_slab(category, case, core, errors, details):
 
 def run_slabs(n):
     cases = generate_slabs(n)
-    core = run_core_slab(cases)
+    core = run_core(cases, "slab")
     errors, details, failures = {}, {}, []
     for (category, case), c in zip(cases, core):
         if "error" in c:
