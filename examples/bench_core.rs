@@ -34,13 +34,14 @@
 #[path = "../tests/spectral_rgb.rs"]
 mod spectral_rgb;
 
-use birefringent::frame::PlaneFrame;
-use birefringent::interface::Interface;
 use birefringent::material::Material;
-use birefringent::medium::Uniaxial;
-use birefringent::slab::{Slab, SlabOptics, Want};
-use birefringent::spectral::integrate::{integrate_set, Output};
-use birefringent::spectral::plate::Plate;
+use birefringent::optics::frame::PlaneFrame;
+use birefringent::optics::interface::Interface;
+use birefringent::optics::medium::Uniaxial;
+use birefringent::plate::slab::Output;
+use birefringent::plate::slab::{Slab, SlabOptics, Want};
+use birefringent::plate::Plate;
+use birefringent::spectral::integrate::integrate_set;
 use birefringent::spectral::weights::weight_per_nm;
 use birefringent::C64;
 use serde_json::{json, Value};

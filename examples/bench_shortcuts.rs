@@ -28,7 +28,7 @@
 //!   on a 100 um plate (a 1000 um one would need ~10^4 panels per query).
 //! * `isotropic_fast_path` (`Uniaxial::is_isotropic`, exact equality of the indices: one mode
 //!   pair instead of o/e, path classes merged in `paths::traverse`, one refracted lobe in
-//!   `sampling::forward_events`). There is no switch to disable it; the full path is timed by
+//!   `render::crystal::forward_events`). There is no switch to disable it; the full path is timed by
 //!   an input that defeats it: `eta_e = eta_o + 1e-9` (optically the same plate, anisotropic to
 //!   the core). Timed for the exact plate at one wavelength (filter 0), the 4 nm band of a
 //!   1000 um plate, and the bulk crystal surface (`crystal_lobes`).
@@ -37,14 +37,18 @@
 //!   Full = reflection and transmission. Timed on the exact plate (filter 0) and the 4 nm band of
 //!   a 1000 um plate.
 
-use birefringent::frame::PlaneFrame;
+use birefringent::band::narrow_band;
 use birefringent::material::Material;
-use birefringent::medium::Uniaxial;
-use birefringent::sampling::{crystal_lobes, plate_lobes, PlateQuery, Spectrum, Transport};
-use birefringent::slab::Want;
-use birefringent::spectral::integrate::{integrate_with, narrow_band, Method, Output};
-use birefringent::spectral::plate::Plate;
-use birefringent::surface::Surface;
+use birefringent::optics::frame::PlaneFrame;
+use birefringent::optics::medium::Uniaxial;
+use birefringent::optics::surface::Surface;
+use birefringent::plate::slab::Output;
+use birefringent::plate::slab::Want;
+use birefringent::plate::Plate;
+use birefringent::render::crystal::crystal_lobes;
+use birefringent::render::plate::{plate_lobes, PlateQuery, Spectrum};
+use birefringent::render::Transport;
+use birefringent::spectral::integrate::{integrate_with, Method};
 use birefringent::C64;
 use nalgebra::Vector3;
 use serde_json::{json, Value};

@@ -14,12 +14,14 @@
 //! scene, x-cut on black silica, `plate_film_scene_rgb`). Directions: 64 on a spiral up
 //! to `THETA_MAX` degrees from the normal (default 80).
 
-use birefringent::interface::Interface;
 use birefringent::material::Material;
-use birefringent::medium::Uniaxial;
-use birefringent::sampling::{crystal_lobes, plate_lobes, PlateQuery, Spectrum, Transport};
+use birefringent::optics::interface::Interface;
+use birefringent::optics::medium::Uniaxial;
+use birefringent::optics::surface::Surface;
+use birefringent::render::crystal::crystal_lobes;
+use birefringent::render::plate::{plate_lobes, PlateQuery, Spectrum};
+use birefringent::render::Transport;
 use birefringent::spectral::weights::WeightSet;
-use birefringent::surface::Surface;
 use birefringent::C64;
 use nalgebra::Vector3;
 use std::hint::black_box;

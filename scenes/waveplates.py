@@ -15,7 +15,7 @@ at 45 degrees to its axis into circular light (S3 / S0 = +1 for crystalline quar
 crystal, with this geometry), a half-wave plate (delta = pi) reflects the plane of polarisation
 about its axis: the angle of linear polarisation goes from 45 to 2 x 15 - 45 = -15 degrees. The
 thicknesses are d = lambda0 / (4 (n_e - n_o)) and lambda0 / (2 (n_e - n_o)) at lambda0 = 550 nm,
-with n_e - n_o of quartz from the core's catalogue (Ghosh 1999, see src/crystals.rs), asked of the
+with n_e - n_o of quartz from the core's catalogue (Ghosh 1999, see src/material/crystals.rs), asked of the
 `birefringence` calculator (the indices of the o and e waves at normal incidence): 15.01 um and
 30.02 um. A real plate is also a thin etalon: its two faces reflect ~4.6 % each, and the multiple
 reflections (which `thinbirefringent` includes, coherently with `filter_bandwidth` 0) change each

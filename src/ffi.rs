@@ -7,12 +7,12 @@
 
 use crate::error::{Error, Result};
 use crate::material::Material;
-use crate::medium::Uniaxial;
-use crate::sampling::{
-    crystal_lobes, plate_lobes, PathLobe, PlateQuery, Spectrum, Transport, MAX_BANDS,
-};
+use crate::optics::medium::Uniaxial;
+use crate::optics::surface::Surface;
+use crate::render::crystal::crystal_lobes;
+use crate::render::plate::{plate_lobes, PlateQuery, Spectrum, MAX_BANDS};
+use crate::render::{PathLobe, Transport};
 use crate::spectral::weights::WeightSet;
-use crate::surface::Surface;
 use crate::C64;
 use nalgebra::Vector3;
 use std::ffi::CStr;

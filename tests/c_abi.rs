@@ -4,10 +4,12 @@
 
 use birefringent::ffi::{BfrComplex, BfrGeometry, BfrMaterialDesc, BfrPathLobe};
 use birefringent::material::Material;
-use birefringent::medium::Uniaxial;
-use birefringent::sampling::{crystal_lobes, plate_lobes, PlateQuery, Spectrum, Transport};
+use birefringent::optics::medium::Uniaxial;
+use birefringent::optics::surface::Surface;
+use birefringent::render::crystal::crystal_lobes;
+use birefringent::render::plate::{plate_lobes, PlateQuery, Spectrum};
+use birefringent::render::Transport;
 use birefringent::spectral::weights::WeightSet;
-use birefringent::surface::Surface;
 use birefringent::C64;
 use nalgebra::Vector3;
 use std::path::{Path, PathBuf};
@@ -64,7 +66,7 @@ fn numbers(line: &str) -> Vec<f64> {
         .collect()
 }
 
-fn expect_lobe(line: &str, l: Option<&birefringent::sampling::PathLobe>) {
+fn expect_lobe(line: &str, l: Option<&birefringent::render::PathLobe>) {
     let f = numbers(line);
     match l {
         None => assert_eq!(f[0], 0.0, "{line}"),

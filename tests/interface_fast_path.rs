@@ -1,5 +1,5 @@
 //! The admittance fast path of an interface with one isotropic side
-//! (`Interface::solve` → `birefringent::admittance`) against the general 4x4 boundary solve
+//! (`Interface::solve` → `birefringent::optics::admittance`) against the general 4x4 boundary solve
 //! (`Interface::from_modes`) it replaces, on random interfaces in both orders.
 //!
 //! Tolerance: `max |S_fast − S_4x4| / max |S_4x4|` (entrywise, relative to the largest entry)
@@ -18,12 +18,12 @@
 //! unit tests of `admittance` and `fields` check that the two arithmetics agree bit for bit on
 //! real inputs).
 
-use birefringent::admittance;
-use birefringent::frame::PlaneFrame;
-use birefringent::interface::Interface;
-use birefringent::medium::Uniaxial;
-use birefringent::modes::modes;
-use birefringent::slab::Slab;
+use birefringent::optics::admittance;
+use birefringent::optics::frame::PlaneFrame;
+use birefringent::optics::interface::Interface;
+use birefringent::optics::medium::Uniaxial;
+use birefringent::optics::modes::modes;
+use birefringent::plate::slab::Slab;
 use birefringent::C64;
 use nalgebra::{Matrix4, Vector3};
 

@@ -2,11 +2,11 @@
 //! amplitudes in the isotropic limit, calcite walk-off, critical incidence, the ray ↔ wave map,
 //! and degenerate or extreme inputs.
 
-use birefringent::frame::PlaneFrame;
-use birefringent::interface::Interface;
-use birefringent::medium::Uniaxial;
-use birefringent::modes::{extraordinary_wave_vector_from_ray, k_max, ModeKind};
-use birefringent::surface::{Incident, Surface};
+use birefringent::optics::frame::PlaneFrame;
+use birefringent::optics::interface::Interface;
+use birefringent::optics::medium::Uniaxial;
+use birefringent::optics::modes::{extraordinary_wave_vector_from_ray, k_max, ModeKind};
+use birefringent::optics::surface::{Incident, Surface};
 use birefringent::C64;
 use nalgebra::Vector3;
 

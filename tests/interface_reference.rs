@@ -1,4 +1,4 @@
-//! Compares the crate's closed-form interface solution (`birefringent::interface`) with the
+//! Compares the crate's closed-form interface solution (`birefringent::optics::interface`) with the
 //! independent Berreman 4x4 reference in `common::berreman`, on many random configurations,
 //! and tests the reference's plate solver on its own.
 //!
@@ -9,7 +9,8 @@
 
 mod common;
 
-use birefringent::{interface::Interface, medium::Uniaxial, modes::Mode, C64};
+use birefringent::optics::{interface::Interface, medium::Uniaxial, modes::Mode};
+use birefringent::C64;
 use common::berreman::{self, Waves};
 use common::Rng;
 use nalgebra::{Matrix3, Vector3, Vector4};
@@ -774,7 +775,7 @@ fn special_configurations() {
 #[test]
 fn absorbing_exteriors_are_refused_with_a_clear_error() {
     let crystal = Uniaxial::isotropic(c(2.0, 0.0)).unwrap();
-    let e = birefringent::surface::Surface::new(c(1.5, 0.1), crystal).unwrap_err();
+    let e = birefringent::optics::surface::Surface::new(c(1.5, 0.1), crystal).unwrap_err();
     assert_eq!(e.parameter, "ext_ior");
     assert!(e.message.contains("absorbing"), "{e}");
 }

@@ -2,15 +2,17 @@
 //! Fresnel interface against the 4x4 boundary solve, and the etalon plate (exact and
 //! band-integrated) against the general slab and the general band integration.
 
-use birefringent::etalon::Etalon;
-use birefringent::frame::PlaneFrame;
-use birefringent::interface::Interface;
+use birefringent::band::narrow_band;
 use birefringent::material::Material;
-use birefringent::medium::Uniaxial;
-use birefringent::modes::modes;
-use birefringent::slab::Want;
-use birefringent::spectral::integrate::{integrate, integrate_with, narrow_band, Method, Output};
-use birefringent::spectral::plate::Plate;
+use birefringent::optics::frame::PlaneFrame;
+use birefringent::optics::interface::Interface;
+use birefringent::optics::medium::Uniaxial;
+use birefringent::optics::modes::modes;
+use birefringent::plate::etalon::Etalon;
+use birefringent::plate::slab::Output;
+use birefringent::plate::slab::Want;
+use birefringent::plate::Plate;
+use birefringent::spectral::integrate::{integrate, integrate_with, Method};
 use birefringent::spectral::weights::{gaussians, WeightSet};
 use birefringent::C64;
 use nalgebra::{Matrix4, Vector3};
@@ -135,7 +137,7 @@ fn etalon_band_equals_the_general_band_integration() {
         } else {
             *srgb[rng.index(srgb.len())]
         };
-        let band = [birefringent::spectral::weights::Gaussian {
+        let band = [birefringent::band::Gaussian {
             amplitude: 1.0,
             ..g
         }];
@@ -223,8 +225,9 @@ fn fast_path_declines_what_it_cannot_do() {
 /// both transport modes, both sides, TIR from inside included.
 #[test]
 fn isotropic_crystal_lobes_equal_the_full_computation() {
-    use birefringent::sampling::{crystal_lobes, crystal_lobes_full, Transport};
-    use birefringent::surface::Surface;
+    use birefringent::optics::surface::Surface;
+    use birefringent::render::crystal::{crystal_lobes, crystal_lobes_full};
+    use birefringent::render::Transport;
     let mut rng = Rng::new(74);
     let (mut worst, mut cases, mut tir) = (0.0f64, 0, 0);
     for _ in 0..5_000 {
@@ -269,7 +272,8 @@ fn isotropic_crystal_lobes_equal_the_full_computation() {
 /// transport modes, both sides, exact, band-filtered and sRGB spectra.
 #[test]
 fn isotropic_plate_lobes_shared_equal_per_lobe_solutions() {
-    use birefringent::sampling::{plate_lobes, plate_lobes_full, PlateQuery, Spectrum, Transport};
+    use birefringent::render::plate::{plate_lobes, plate_lobes_full, PlateQuery, Spectrum};
+    use birefringent::render::Transport;
     let mut rng = Rng::new(75);
     let (mut worst, mut lobes) = (0.0f64, 0);
     for i in 0..3_000 {
@@ -330,7 +334,8 @@ fn isotropic_plate_lobes_shared_equal_per_lobe_solutions() {
 /// one query per wavelength, isotropic plates (one etalon shared) and birefringent ones alike.
 #[test]
 fn several_wavelengths_in_one_query_equal_single_queries() {
-    use birefringent::sampling::{plate_lobes, PlateQuery, Spectrum, Transport, MAX_BANDS};
+    use birefringent::render::plate::{plate_lobes, PlateQuery, Spectrum, MAX_BANDS};
+    use birefringent::render::Transport;
     let mut rng = Rng::new(76);
     let mut worst = 0.0f64;
     for i in 0..400 {
@@ -401,7 +406,8 @@ fn several_wavelengths_in_one_query_equal_single_queries() {
 /// The shared isotropic path validates the wavelengths as the general path does.
 #[test]
 fn isotropic_plate_refuses_invalid_wavelengths() {
-    use birefringent::sampling::{plate_lobes, PlateQuery, Spectrum, Transport};
+    use birefringent::render::plate::{plate_lobes, PlateQuery, Spectrum};
+    use birefringent::render::Transport;
     let q = PlateQuery::new(
         Material::constant(re(1.5), re(1.5)).unwrap(),
         0.0,

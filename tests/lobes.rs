@@ -2,10 +2,10 @@
 //! Mitsuba's own Fresnel Mueller matrices (`mueller::specular_reflection/transmission` of
 //! Mitsuba 3.9.1, re-derived here from their published formulas, not from our code).
 
-use birefringent::lobes::{scatter, Event, Lobe};
-use birefringent::medium::Uniaxial;
-use birefringent::modes::ModeKind;
-use birefringent::surface::{Incident, Surface};
+use birefringent::optics::lobes::{scatter, Event, Lobe};
+use birefringent::optics::medium::Uniaxial;
+use birefringent::optics::modes::ModeKind;
+use birefringent::optics::surface::{Incident, Surface};
 use birefringent::C64;
 use nalgebra::{Matrix4, Vector3, Vector4};
 

@@ -14,13 +14,14 @@
 //! (a fixed seed; `PROPTEST_RNG_SEED` explores others). Each test prints, per quantity, the
 //! number of comparisons, the worst error and the worst error / tolerance.
 
-use birefringent::frame::PlaneFrame;
 use birefringent::material::Material;
-use birefringent::medium::Uniaxial;
-use birefringent::modes::ModeKind;
-use birefringent::sampling::{crystal_lobes, Transport};
-use birefringent::slab::{Slab, Want};
-use birefringent::surface::{Incident, Surface};
+use birefringent::optics::frame::PlaneFrame;
+use birefringent::optics::medium::Uniaxial;
+use birefringent::optics::modes::ModeKind;
+use birefringent::optics::surface::{Incident, Surface};
+use birefringent::plate::slab::{Slab, Want};
+use birefringent::render::crystal::crystal_lobes;
+use birefringent::render::Transport;
 use birefringent::C64;
 use nalgebra::{Matrix2, Rotation3, Vector3};
 use proptest::prelude::*;
@@ -122,7 +123,7 @@ prop_compose! {
 /// down₂]`) waves of an interface propagate. (`Interface::power` divides by the incoming
 /// wave's flux even when that is round-off of an evanescent wave, ~1e-18, so only columns of
 /// propagating incoming waves are meaningful; see the report of issue 6.)
-fn propagating(i: &birefringent::interface::Interface) -> ([bool; 4], [bool; 4]) {
+fn propagating(i: &birefringent::optics::interface::Interface) -> ([bool; 4], [bool; 4]) {
     let inc = [
         i.upper.down[0],
         i.upper.down[1],

@@ -2,9 +2,10 @@
 //! Radiance and Importance agree on the isotropic dielectric (Mitsuba's own weights), and
 //! energy is conserved in Importance mode.
 
-use birefringent::medium::Uniaxial;
-use birefringent::sampling::{crystal_lobes, Transport};
-use birefringent::surface::Surface;
+use birefringent::optics::medium::Uniaxial;
+use birefringent::optics::surface::Surface;
+use birefringent::render::crystal::crystal_lobes;
+use birefringent::render::Transport;
 use birefringent::C64;
 use nalgebra::Vector3;
 
@@ -77,7 +78,7 @@ fn isotropic_crystal_weights_are_mitsubas_dielectric_weights() {
 #[test]
 fn intensity_only_plate_queries_return_m00_alone() {
     use birefringent::material::Material;
-    use birefringent::sampling::{plate_lobes, PlateQuery, Spectrum};
+    use birefringent::render::plate::{plate_lobes, PlateQuery, Spectrum};
     let mut rng = Rng::new(33);
     for i in 0..200 {
         let material = if i % 2 == 0 {
@@ -124,7 +125,7 @@ fn intensity_only_plate_queries_return_m00_alone() {
 #[test]
 fn absorbing_exit_keeps_the_front_reflection_only() {
     use birefringent::material::Material;
-    use birefringent::sampling::{plate_lobes, PlateQuery, Spectrum};
+    use birefringent::render::plate::{plate_lobes, PlateQuery, Spectrum};
     let mut rng = Rng::new(34);
     let q = PlateQuery::new(
         Material::named("quartz", 0.0, 0.0).unwrap(),
@@ -172,11 +173,12 @@ fn absorbing_exit_keeps_the_front_reflection_only() {
 /// thin_film scene's scalar_rgb image was 0.06 (in units of the light) too red there.
 #[test]
 fn srgb_lobes_keep_negative_channels() {
-    use birefringent::frame::PlaneFrame;
     use birefringent::material::Material;
-    use birefringent::sampling::{plate_lobes, PlateQuery, Spectrum};
-    use birefringent::slab::Want;
-    use birefringent::spectral::integrate::{integrate_set, Output};
+    use birefringent::optics::frame::PlaneFrame;
+    use birefringent::plate::slab::Output;
+    use birefringent::plate::slab::Want;
+    use birefringent::render::plate::{plate_lobes, PlateQuery, Spectrum};
+    use birefringent::spectral::integrate::integrate_set;
     use birefringent::spectral::weights::WeightSet;
     let q = PlateQuery::new(
         Material::named("linbo3", 0.0, 0.0).unwrap(),
@@ -264,7 +266,7 @@ fn absorbing_bulk_surface_is_opaque_from_inside() {
 #[test]
 fn vanishing_bandwidth_is_exact() {
     use birefringent::material::Material;
-    use birefringent::sampling::{plate_lobes, PlateQuery, Spectrum};
+    use birefringent::render::plate::{plate_lobes, PlateQuery, Spectrum};
     let q = PlateQuery::new(
         Material::named("quartz", 0.0, 0.0).unwrap(),
         0.0,

@@ -2,10 +2,10 @@
 //! conservation, the retarder limit, the incoherent thick-plate limit (Mitsuba's
 //! `thindielectric` formula), and the path expansion against the exact sum.
 
-use birefringent::frame::PlaneFrame;
-use birefringent::medium::Uniaxial;
-use birefringent::paths::PathExpansion;
-use birefringent::slab::{Slab, Want};
+use birefringent::optics::frame::PlaneFrame;
+use birefringent::optics::medium::Uniaxial;
+use birefringent::plate::paths::PathExpansion;
+use birefringent::plate::slab::{Slab, Want};
 use birefringent::C64;
 use nalgebra::{Matrix2, Vector3};
 
@@ -190,7 +190,7 @@ fn thick_isotropic_plate_incoherent_limit_is_the_thindielectric_series() {
             let r = j.r.unwrap();
             rs += r[(0, 0)].norm_sqr() / steps as f64;
             rp += r[(1, 1)].norm_sqr() / steps as f64;
-            m00 += birefringent::mueller::from_jones(&r)[(0, 0)] / steps as f64;
+            m00 += birefringent::optics::mueller::from_jones(&r)[(0, 0)] / steps as f64;
         }
         let f = fresnel(re(1.0), re(n), beta);
         let (r1s, r1p) = (f[0].norm_sqr(), f[1].norm_sqr());
@@ -210,7 +210,7 @@ fn thick_isotropic_plate_incoherent_limit_is_the_thindielectric_series() {
         let incoherent: f64 = paths
             .reflection
             .iter()
-            .map(|c| birefringent::mueller::from_jones(&c.amplitude)[(0, 0)])
+            .map(|c| birefringent::optics::mueller::from_jones(&c.amplitude)[(0, 0)])
             .sum::<f64>()
             + paths.tail.r[(0, 0)];
         assert!((incoherent - 0.5 * (series(r1s) + series(r1p))).abs() < 1e-12);

@@ -3,9 +3,9 @@
 //! (10 nm to 5 mm, tilted axes, absorbing and strongly dichroic, total internal reflection
 //! inside, incidence up to 85°).
 
-use birefringent::frame::PlaneFrame;
-use birefringent::medium::Uniaxial;
-use birefringent::slab::{Slab, Want};
+use birefringent::optics::frame::PlaneFrame;
+use birefringent::optics::medium::Uniaxial;
+use birefringent::plate::slab::{Slab, Want};
 use birefringent::C64;
 
 mod common;

@@ -2,13 +2,13 @@
 //! (the same weight on both sides, so only the closed form is tested), and the shortcuts
 //! against the full computation.
 
-use birefringent::frame::PlaneFrame;
+use birefringent::band::narrow_band;
 use birefringent::material::Material;
-use birefringent::slab::Want;
-use birefringent::spectral::integrate::{
-    integrate, integrate_with, narrow_band, quadrature, Method, Output,
-};
-use birefringent::spectral::plate::Plate;
+use birefringent::optics::frame::PlaneFrame;
+use birefringent::plate::slab::Output;
+use birefringent::plate::slab::Want;
+use birefringent::plate::Plate;
+use birefringent::spectral::integrate::{integrate, integrate_with, quadrature, Method};
 use birefringent::C64;
 use nalgebra::{Matrix4, Vector3};
 

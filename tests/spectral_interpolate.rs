@@ -1,9 +1,9 @@
 //! The interpolated blocks of a dispersive plate (`spectral::interpolate`) against the exact
 //! blocks (both interfaces solved at the wavenumber) and the plate's Mueller matrices from each.
 
-use birefringent::frame::PlaneFrame;
 use birefringent::material::Material;
-use birefringent::slab::Want;
+use birefringent::optics::frame::PlaneFrame;
+use birefringent::plate::slab::Want;
 use birefringent::spectral::interpolate::{BlockInterpolant, TOLERANCE};
 use birefringent::C64;
 

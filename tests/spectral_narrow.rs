@@ -2,13 +2,13 @@
 //! matrix etalon) against composite Gauss–Legendre quadrature of the exact plate over the same
 //! Gaussian (every node solves both interfaces at its own wavelength).
 
-use birefringent::frame::PlaneFrame;
+use birefringent::band::narrow_band;
 use birefringent::material::Material;
-use birefringent::slab::Want;
-use birefringent::spectral::integrate::{
-    integrate_with, narrow_band, narrow_closed_form, Method, Output,
-};
-use birefringent::spectral::plate::Plate;
+use birefringent::optics::frame::PlaneFrame;
+use birefringent::plate::slab::Output;
+use birefringent::plate::slab::Want;
+use birefringent::plate::Plate;
+use birefringent::spectral::integrate::{integrate_with, narrow_closed_form, Method};
 use birefringent::C64;
 
 mod common;

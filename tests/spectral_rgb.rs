@@ -30,11 +30,12 @@
 //! (`--validate N`), which includes this file as a module.
 #![allow(dead_code)]
 
-use birefringent::frame::PlaneFrame;
 use birefringent::material::{Index, Material};
-use birefringent::slab::{SlabMueller, Want};
-use birefringent::spectral::integrate::{integrate_set, Output};
-use birefringent::spectral::plate::Plate;
+use birefringent::optics::frame::PlaneFrame;
+use birefringent::plate::slab::Output;
+use birefringent::plate::slab::{SlabMueller, Want};
+use birefringent::plate::Plate;
+use birefringent::spectral::integrate::integrate_set;
 use birefringent::spectral::weights::{ciede2000, gaussians, weight_per_nm, xyz_to_lab, WeightSet};
 use birefringent::C64;
 use nalgebra::Vector3;

@@ -2,12 +2,12 @@
 //! a dense composite Gauss–Legendre rule of the exact plate (both interfaces solved at every
 //! node, no interpolation, 1024 panels over the same support; the shared rule interpolates on Chebyshev points), Mueller matrices entry by entry.
 
-use birefringent::frame::PlaneFrame;
 use birefringent::material::Material;
-use birefringent::slab::Want;
+use birefringent::optics::frame::PlaneFrame;
+use birefringent::plate::slab::Output;
+use birefringent::plate::slab::Want;
+use birefringent::plate::Plate;
 use birefringent::spectral::hermite;
-use birefringent::spectral::integrate::Output;
-use birefringent::spectral::plate::Plate;
 use birefringent::spectral::shared::{self, support, TOLERANCE};
 use birefringent::spectral::weights::{gaussians, WeightSet};
 use birefringent::C64;

@@ -11,14 +11,14 @@ use birefringent::ffi::{
     BfrGeometry, BfrMaterialDesc, BfrPathLobe, BFR_CRYSTAL_LOBES, BFR_IMPORTANCE, BFR_INVALID,
     BFR_OK, BFR_RADIANCE, BFR_WANT_REFLECTION, BFR_WANT_TRANSMISSION,
 };
-use birefringent::frame::PlaneFrame;
-use birefringent::interface::Interface;
 use birefringent::material::Material;
-use birefringent::medium::Uniaxial;
-use birefringent::modes::ModeKind;
-use birefringent::slab::{Slab, Want};
-use birefringent::spectral::plate::Plate;
-use birefringent::surface::{Incident, Surface};
+use birefringent::optics::frame::PlaneFrame;
+use birefringent::optics::interface::Interface;
+use birefringent::optics::medium::Uniaxial;
+use birefringent::optics::modes::ModeKind;
+use birefringent::optics::surface::{Incident, Surface};
+use birefringent::plate::slab::{Slab, Want};
+use birefringent::plate::Plate;
 use birefringent::C64;
 use nalgebra::{Matrix4, Vector3};
 use std::ffi::CString;

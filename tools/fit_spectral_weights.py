@@ -512,7 +512,7 @@ def generate(data, sets, fits) -> str:
     for line in report_lines(fits, fringe_delta_e(fits, sets, data)):
         out.append(("// " + line).rstrip())
     out.append("")
-    out.append("use super::weights::Gaussian;")
+    out.append("use crate::band::Gaussian;")
     out.append("")
     out.append(rs_float_const("LAMBDA_MIN_NM", LAMBDA_MIN_NM, "First wavelength of the tables (nm)."))
     out.append(rs_float_const("LAMBDA_MAX_NM", LAMBDA_MAX_NM, "Last wavelength of the tables (nm)."))

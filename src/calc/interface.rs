@@ -4,9 +4,9 @@ use super::input::Fields;
 use super::media;
 use super::output::{complex, num, wave};
 use crate::error::{Error, Result};
-use crate::frame::PlaneFrame;
-use crate::modes::ModeKind;
-use crate::surface::{Incident, Solved, Surface};
+use crate::optics::frame::PlaneFrame;
+use crate::optics::modes::ModeKind;
+use crate::optics::surface::{Incident, Solved, Surface};
 use num_complex::Complex64 as C64;
 use serde_json::{json, Map, Value};
 

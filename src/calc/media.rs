@@ -1,10 +1,10 @@
 //! The media fields shared by every calculator subcommand.
 
 use super::input::Fields;
-use crate::crystals;
 use crate::error::{Error, Result};
+use crate::material::crystals;
 use crate::material::Material;
-use crate::medium::Uniaxial;
+use crate::optics::medium::Uniaxial;
 use nalgebra::Vector3;
 use num_complex::Complex64 as C64;
 

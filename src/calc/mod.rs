@@ -17,7 +17,7 @@ pub const SUBCOMMANDS: [&str; 2] = ["interface", "slab"];
 pub fn run(subcommand: &str, input: &Value) -> Result<Value> {
     match subcommand {
         "interface" => interface::run(input),
-        "slab" => slab::run(input),
+        "slab" => run_slab(input),
         _ => Err(Error::new(
             "subcommand",
             format!(
@@ -25,6 +25,15 @@ pub fn run(subcommand: &str, input: &Value) -> Result<Value> {
                 SUBCOMMANDS.join(", ")
             ),
         )),
+    }
+}
+
+/// The `slab` subcommand: the slab at one wavelength, or over the `spectrum` the input asks for.
+fn run_slab(input: &Value) -> Result<Value> {
+    let fields = slab::slab_fields();
+    match input::Fields::new(input, &fields)?.get("spectrum") {
+        None => slab::run_monochromatic(input, &fields),
+        Some(spec) => spectrum::run(input, &fields, spec),
     }
 }
 

@@ -1,7 +1,7 @@
 //! JSON encodings of the calculator's outputs.
 
-use crate::modes::Mode;
-use crate::surface::Solved;
+use crate::optics::modes::Mode;
+use crate::optics::surface::Solved;
 use nalgebra::Vector3;
 use num_complex::Complex64 as C64;
 use serde_json::{json, Value};

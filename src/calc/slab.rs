@@ -5,9 +5,9 @@ use super::interface::read_incidence;
 use super::media;
 use super::output::{complex, num};
 use crate::error::{Error, Result};
-use crate::slab::{Slab, Want};
-use crate::spectral::plate::Plate;
-use crate::surface::Surface;
+use crate::optics::surface::Surface;
+use crate::plate::slab::{Slab, Want};
+use crate::plate::Plate;
 use nalgebra::{Matrix2, Matrix4};
 use num_complex::Complex64 as C64;
 use serde_json::{json, Map, Value};
@@ -21,7 +21,7 @@ pub struct SlabQuery {
     /// Vacuum wavelength (nm).
     pub wavelength_nm: f64,
     /// Plane of incidence.
-    pub frame: crate::frame::PlaneFrame,
+    pub frame: crate::optics::frame::PlaneFrame,
     /// Incidence parameter.
     pub beta: C64,
 }
@@ -56,16 +56,6 @@ pub fn read(f: &mut Fields) -> Result<SlabQuery> {
     })
 }
 
-/// Runs the `slab` subcommand on one input object.
-pub fn run(input: &Value) -> Result<Value> {
-    let fields = slab_fields();
-    let spectrum = Fields::new(input, &fields)?.get("spectrum");
-    match spectrum {
-        None => run_monochromatic(input, &fields),
-        Some(spec) => super::spectrum::run(input, &fields, spec),
-    }
-}
-
 /// The accepted fields of `slab`.
 pub fn slab_fields() -> Vec<&'static str> {
     super::interface::FIELDS
@@ -76,8 +66,8 @@ pub fn slab_fields() -> Vec<&'static str> {
         .collect()
 }
 
-/// The slab at exactly `wavelength_nm`.
-fn run_monochromatic(input: &Value, fields: &[&str]) -> Result<Value> {
+/// The `slab` subcommand without a `spectrum`: the slab at exactly `wavelength_nm`.
+pub fn run_monochromatic(input: &Value, fields: &[&str]) -> Result<Value> {
     let mut f = Fields::new(input, fields)?;
     let q = read(&mut f)?;
     let optics = q.slab.optics(&q.frame, q.beta)?;
@@ -88,8 +78,8 @@ fn run_monochromatic(input: &Value, fields: &[&str]) -> Result<Value> {
     out.insert("T".into(), powers(&t));
     out.insert("jones".into(), json!({"R": jones(&r), "T": jones(&t)}));
     let (mr, mt) = (
-        crate::mueller::from_jones(&r),
-        crate::mueller::from_jones(&t),
+        crate::optics::mueller::from_jones(&r),
+        crate::optics::mueller::from_jones(&t),
     );
     out.insert(
         "mueller".into(),

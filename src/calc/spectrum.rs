@@ -5,11 +5,11 @@
 use super::input::Fields;
 use super::output::num;
 use super::slab::{matrix, read, SlabQuery};
+use crate::band::{is_exact_band, narrow_band};
 use crate::error::{Error, Result};
-use crate::slab::{SlabMueller, Want};
-use crate::spectral::integrate::{
-    integrate, integrate_set, is_exact_band, narrow_band, quadrature, Output,
-};
+use crate::plate::slab::Output;
+use crate::plate::slab::{SlabMueller, Want};
+use crate::spectral::integrate::{integrate, integrate_set, quadrature};
 use crate::spectral::weights::{weight_per_nm, WeightSet};
 use nalgebra::{Matrix4, Vector4};
 use serde_json::{json, Map, Value};

@@ -14,29 +14,31 @@
 //! Gaussian decay of the notes). Absorption enters `Φ₁` as its imaginary part (exact for an
 //! attenuation `exp(−k d Im ΔQ)` linear in `k`); Fresnel amplitudes are evaluated at `μ` (they
 //! vary slowly). Orders beyond `N` are the
-//! incoherent closed-form tail of [`crate::paths`]. Pairs whose group path difference is far
+//! incoherent closed-form tail of [`crate::plate::paths`]. Pairs whose group path difference is far
 //! beyond the coherence length `1/σ` are skipped (their factor is below `e^{-18}`).
 //!
 //! [`Method::Auto`] first takes the closed forms that need no choice of order: a lossless
-//! isotropic plate is two Airy etalons ([`crate::etalon`], exact for Gaussians), and a narrow
+//! isotropic plate is two Airy etalons ([`crate::plate::etalon`], exact for Gaussians), and a narrow
 //! Gaussian (σ ≤ [`NARROW_BAND`] μ) through any plate is the matrix etalon of
 //! [`crate::spectral::narrow`] where its residual phases are resolved by a few nodes. The
 //! shared quadrature of [`integrate_set`] interpolates a dispersive plate's interface blocks
 //! across the band ([`crate::spectral::interpolate`]) and sizes its rule order by order
 //! ([`crate::spectral::shared`]).
 
+use crate::band::Gaussian;
 use crate::cmath;
 use crate::error::{Error, Result};
-use crate::etalon::Etalon;
-use crate::frame::PlaneFrame;
-use crate::mueller;
-use crate::paths::{PathClass, PathExpansion};
-use crate::slab::{SlabMueller, SlabOptics, Want};
+use crate::optics::frame::PlaneFrame;
+use crate::optics::mueller;
+use crate::plate::etalon::Etalon;
+use crate::plate::paths::{PathClass, PathExpansion};
+use crate::plate::slab::{Output, SlabMueller, SlabOptics, Want};
+use crate::plate::Plate;
+use crate::spectral::group::{dispersion, group_round_trips, Dispersion};
 use crate::spectral::hermite;
 use crate::spectral::narrow;
-use crate::spectral::plate::Plate;
 use crate::spectral::shared;
-use crate::spectral::weights::{gaussians, Gaussian, WeightSet};
+use crate::spectral::weights::{gaussians, WeightSet};
 use nalgebra::{Matrix2, Matrix4};
 use num_complex::Complex64 as C64;
 
@@ -51,53 +53,6 @@ const PAIR_NEGLIGIBLE: f64 = 1e-12;
 pub const THICK_ORDER: usize = 2;
 /// Pairs with `σ d |ΔG| > PAIR_CUTOFF` are incoherent (factor < e^{-18} ≈ 1.5e-8).
 pub const PAIR_CUTOFF: f64 = 6.0;
-
-/// Bands narrower than this fraction of their wavelength are the exact single-wavelength result:
-/// across such a band the phase of the thickest accepted plate (1 m, index up to ~3) changes by
-/// less than 1e-4 rad, and its Gaussian's width in wavenumber would underflow for the
-/// subnormal widths a caller could pass.
-pub const EXACT_BAND: f64 = 1e-12;
-
-/// True if a band of FWHM `fwhm_nm` around `center_nm` is treated as exact ([`EXACT_BAND`]).
-pub fn is_exact_band(fwhm_nm: f64, center_nm: f64) -> bool {
-    fwhm_nm <= EXACT_BAND * center_nm
-}
-
-/// A unit-mass Gaussian band of full width at half maximum `fwhm_nm` (in wavelength) around
-/// `center_nm`, expressed in wavenumber.
-pub fn narrow_band(center_nm: f64, fwhm_nm: f64) -> Gaussian {
-    let mu = std::f64::consts::TAU / center_nm;
-    let sigma_nm = fwhm_nm / (8.0 * std::f64::consts::LN_2).sqrt();
-    Gaussian {
-        amplitude: 1.0,
-        mu,
-        sigma: mu * sigma_nm / center_nm,
-    }
-}
-
-/// What one band integration returns: Mueller matrices, or only their `M00` when no
-/// polarisation is asked for.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Output {
-    /// Full Mueller matrices.
-    Mueller,
-    /// Intensity only (`M00`, stored in entry (0,0)).
-    Intensity,
-}
-
-impl Output {
-    /// `m` as this output asks: unchanged, or only `M00` (the other entries zero).
-    pub fn keep(self, m: SlabMueller) -> SlabMueller {
-        let cut = |m: Matrix4<f64>| match self {
-            Output::Mueller => m,
-            Output::Intensity => Matrix4::from_fn(|i, j| if i + j == 0 { m[(0, 0)] } else { 0.0 }),
-        };
-        SlabMueller {
-            r: m.r.map(cut),
-            t: m.t.map(cut),
-        }
-    }
-}
 
 /// How the Gaussians of a band are integrated.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -326,24 +281,6 @@ fn traversals(optics: &SlabOptics, disp: &Dispersion, mu: f64) -> [narrow::Trave
     })
 }
 
-/// The smallest and largest group path per unit thickness of one internal round trip,
-/// `d(k Re(q↑ − q↓))/dk` over the mode pairs (the phase index without dispersion).
-pub(crate) fn group_round_trips(optics: &SlabOptics, disp: &Dispersion, mu: f64) -> (f64, f64) {
-    let m = optics.layer_modes();
-    let trips = (0..2).flat_map(|a| {
-        (0..2).map(move |b| (m.up[a].q - m.down[b].q).re + mu * (disp.d1[2 + a] + disp.d1[b]))
-    });
-    trips.fold((f64::INFINITY, 0.0), |(lo, hi), t| (lo.min(t), hi.max(t)))
-}
-
-/// The largest difference of group path per unit thickness between the two modes travelling
-/// the same way, `d(k Re(q_o − q_e))/dk` (the direct paths' birefringent oscillation).
-pub(crate) fn group_splitting(optics: &SlabOptics, disp: &Dispersion, mu: f64) -> f64 {
-    let q = optics.layer_q();
-    let g = |j: usize| q[j].re + mu * disp.d1[j] * if j < 2 { -1.0 } else { 1.0 };
-    (g(0) - g(1)).abs().max((g(2) - g(3)).abs())
-}
-
 /// [`Method::Auto`]'s choice for one Gaussian. With `a = σ D` per round trip and `N` the
 /// number of round trips whose amplitude exceeds [`ORDER_TOLERANCE`], the integrand oscillates
 /// up to `a (N + 1)` radians per band width: Gauss–Hermite with `8 + 3x + x²` nodes integrates
@@ -453,37 +390,6 @@ pub fn integrate_set(
             Ok([one(0)?, one(1)?, one(2)?])
         }
     }
-}
-
-/// First and second derivatives in `k` of the phase-per-traversal `Q` of the layer's four modes
-/// `[o↓, e↓, o↑, e↑]` at wavenumber `mu` (zero without dispersion), by central differences of
-/// the exact modes (step `10⁻³ μ`: truncation ~10⁻⁶, rounding ~10⁻¹⁰ relative).
-pub(crate) fn dispersion(
-    plate: &Plate,
-    frame: &PlaneFrame,
-    beta: C64,
-    mu: f64,
-) -> Result<Dispersion> {
-    if !plate.is_dispersive() {
-        return Ok(Dispersion::default());
-    }
-    let h = mu * 1e-3;
-    let q = |k: f64| -> Result<[C64; 4]> {
-        let q = plate.at(std::f64::consts::TAU / k)?.layer_q(frame, beta);
-        Ok([-q[0], -q[1], q[2], q[3]])
-    };
-    let (a, b, c) = (q(mu + h)?, q(mu)?, q(mu - h)?);
-    Ok(Dispersion {
-        d1: std::array::from_fn(|i| ((a[i] - c[i]) / (2.0 * h)).re),
-        d2: std::array::from_fn(|i| ((a[i] - b[i] * 2.0 + c[i]) / (h * h)).re),
-    })
-}
-
-/// `dQ/dk` and `d²Q/dk²` per mode (see [`dispersion`]).
-#[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct Dispersion {
-    d1: [f64; 4],
-    d2: [f64; 4],
 }
 
 /// The coherent order `N` of the path-class method: enough round trips for the amplitude to

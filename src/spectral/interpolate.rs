@@ -14,7 +14,7 @@
 //! caller solves every node exactly.
 
 use crate::error::Result;
-use crate::slab::{SlabBlocks, BLOCK_VALUES};
+use crate::plate::slab::{SlabBlocks, BLOCK_VALUES};
 use num_complex::Complex64 as C64;
 
 /// Chebyshev nodes of the interpolant.

@@ -29,10 +29,10 @@
 //! internal order included. The residuals are complex (absorption varies across the band with
 //! `Im G_j`) and also carry the curvature `κ² C_j/2` of each traversal's phase.
 
+use crate::band::Gaussian;
 use crate::cmath;
-use crate::slab::{SlabOptics, Want};
+use crate::plate::slab::{SlabOptics, Want};
 use crate::spectral::hermite;
-use crate::spectral::weights::Gaussian;
 use nalgebra::{Matrix2, Matrix4};
 use num_complex::Complex64 as C64;
 
@@ -120,7 +120,7 @@ pub fn band(
         }
     }
     let close = |c: Matrix4<C64>, mirrored: Matrix4<C64>| {
-        crate::mueller::from_coherency(&(c + mirrored + swap(&mirrored.map(|z| z.conj()))))
+        crate::optics::mueller::from_coherency(&(c + mirrored + swap(&mirrored.map(|z| z.conj()))))
     };
     let t = if want.transmission {
         close(

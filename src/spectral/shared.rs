@@ -31,14 +31,16 @@
 //! **The points and their weights** depend only on the weight set and the number of points:
 //! they are computed once per (set, rung of [`LADDER`]) and kept, with the rule's error table.
 
+use crate::band::Gaussian;
 use crate::error::Result;
-use crate::frame::PlaneFrame;
-use crate::slab::{SlabBlocks, SlabMueller, Want};
+use crate::optics::frame::PlaneFrame;
+use crate::plate::slab::Output;
+use crate::plate::slab::{SlabBlocks, SlabMueller, Want};
+use crate::plate::Plate;
+use crate::spectral::group::{dispersion, group_round_trips, group_splitting};
 use crate::spectral::hermite;
-use crate::spectral::integrate::{dispersion, group_round_trips, group_splitting, Output};
 use crate::spectral::interpolate::BlockInterpolant;
-use crate::spectral::plate::Plate;
-use crate::spectral::weights::{gaussians, Gaussian, WeightSet};
+use crate::spectral::weights::{gaussians, WeightSet};
 use nalgebra::Matrix4;
 use num_complex::Complex64 as C64;
 use std::f64::consts::TAU;

@@ -20,6 +20,7 @@
 //! colorimetric values (XYZ or linear sRGB with the flat spectrum at `Y = 1`).
 
 use super::weights_data as data;
+use crate::band::Gaussian;
 
 /// A named set of three channel weights.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -85,18 +86,6 @@ impl WeightSet {
             WeightSet::SrgbD65 => &data::NORM_SRGB_D65,
         }
     }
-}
-
-/// One Gaussian term of a fit, in wavenumber `k = 2 pi / lambda` (rad/nm, lambda in nm):
-/// `amplitude * N(k; mu, sigma)` with `N` the unit-mass normal pdf.
-#[derive(Clone, Copy, Debug)]
-pub struct Gaussian {
-    /// Mass of the term (dimensionless; the masses of a channel sum to 1).
-    pub amplitude: f64,
-    /// Mean wavenumber (rad/nm).
-    pub mu: f64,
-    /// Standard deviation in wavenumber (rad/nm).
-    pub sigma: f64,
 }
 
 /// The Gaussian fit of channel `channel` (0, 1, 2) of `set`, per unit wavenumber.

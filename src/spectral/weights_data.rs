@@ -50,7 +50,7 @@
 // max CIEDE2000, closed form vs quadrature, colour of the fringe (1 + cos kD)/2, D in [0, 20 um]:
 //   xyz-e 0.146, xyz-d65 0.460, srgb-d65 0.175
 
-use super::weights::Gaussian;
+use crate::band::Gaussian;
 
 /// First wavelength of the tables (nm).
 pub const LAMBDA_MIN_NM: f64 = 360.0;

@@ -61,9 +61,9 @@ pub fn random_plate(
     material: birefringent::material::Material,
     exit: (f64, f64),
     log10_nm: (f64, f64),
-) -> birefringent::spectral::plate::Plate {
+) -> birefringent::plate::Plate {
     use birefringent::C64;
-    birefringent::spectral::plate::Plate {
+    birefringent::plate::Plate {
         material,
         birefringence: 0.0,
         ext: C64::new(1.0, 0.0),

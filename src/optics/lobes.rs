@@ -12,10 +12,10 @@
 //! wave (seed eq. S19), so the Mueller matrix's `M00` is the power ratio for unpolarised light.
 
 use crate::error::{Error, Result};
-use crate::frame::PlaneFrame;
-use crate::modes::{extraordinary_wave_vector_from_ray, Mode, ModeKind};
-use crate::mueller;
-use crate::surface::{Incident, Solved, Surface};
+use crate::optics::frame::PlaneFrame;
+use crate::optics::modes::{extraordinary_wave_vector_from_ray, Mode, ModeKind};
+use crate::optics::mueller;
+use crate::optics::surface::{Incident, Solved, Surface};
 use nalgebra::{Matrix2, Matrix4, Vector2, Vector3};
 use num_complex::Complex64 as C64;
 

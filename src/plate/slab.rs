@@ -2,7 +2,7 @@
 //! one wavelength: every internal path summed in closed form (physics notes §3; the plane-wave
 //! form of seed eqs. S20-S26).
 //!
-//! With the interface blocks of [`crate::interface`] (top interface: exterior above, crystal
+//! With the interface blocks of [`crate::optics::interface`] (top interface: exterior above, crystal
 //! below; bottom interface: crystal above, exit medium below) and the propagation matrices
 //! `P↓ = diag(exp(−i k0 q↓ d))`, `P↑ = diag(exp(i k0 q↑ d))` of the o/e modes,
 //!
@@ -16,11 +16,12 @@
 
 use crate::cmath;
 use crate::error::{Error, Result};
-use crate::frame::PlaneFrame;
-use crate::interface::Interface;
-use crate::medium::{check_clear_index, Uniaxial};
-use crate::modes::{modes, normal_components, ModeSet};
-use crate::mueller;
+use crate::material::check_clear_index;
+use crate::optics::frame::PlaneFrame;
+use crate::optics::interface::Interface;
+use crate::optics::medium::Uniaxial;
+use crate::optics::modes::{modes, normal_components, ModeSet};
+use crate::optics::mueller;
 use nalgebra::{Matrix2, Matrix4};
 use num_complex::Complex64 as C64;
 
@@ -199,7 +200,7 @@ impl SlabOptics {
     }
 
     /// [`SlabOptics::mueller`] with the interfaces of `self` and the layer phases of the normal
-    /// components `q` (`[o↓, e↓, o↑, e↑]`, e.g. [`crate::modes::normal_components`] at a nearby
+    /// components `q` (`[o↓, e↓, o↑, e↑]`, e.g. [`crate::optics::modes::normal_components`] at a nearby
     /// wavelength): a dispersive plate across a narrow band, where the amplitudes barely change
     /// but the phases do.
     pub fn mueller_with_phases(
@@ -236,7 +237,7 @@ fn propagation(thickness_nm: f64, lambda_nm: f64, q: &[C64; 4]) -> (Matrix2<C64>
 }
 
 /// The diagonals of [`propagation`]. The o-wave's `q↑ = −q↓` (bit for bit, as
-/// [`crate::modes`] builds them) shares one exponential.
+/// [`crate::optics::modes`] builds them) shares one exponential.
 #[inline]
 fn phase_factors(thickness_nm: f64, lambda_nm: f64, q: &[C64; 4]) -> ([C64; 2], [C64; 2]) {
     let kd = std::f64::consts::TAU * thickness_nm / lambda_nm;
@@ -397,6 +398,30 @@ impl SlabBlocks {
             q: [v[24], v[25], v[26], v[27]],
             flux: v[28].re,
             thickness_nm,
+        }
+    }
+}
+
+/// What one band integration returns: Mueller matrices, or only their `M00` when no
+/// polarisation is asked for.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Output {
+    /// Full Mueller matrices.
+    Mueller,
+    /// Intensity only (`M00`, stored in entry (0,0)).
+    Intensity,
+}
+
+impl Output {
+    /// `m` as this output asks: unchanged, or only `M00` (the other entries zero).
+    pub fn keep(self, m: SlabMueller) -> SlabMueller {
+        let cut = |m: Matrix4<f64>| match self {
+            Output::Mueller => m,
+            Output::Intensity => Matrix4::from_fn(|i, j| if i + j == 0 { m[(0, 0)] } else { 0.0 }),
+        };
+        SlabMueller {
+            r: m.r.map(cut),
+            t: m.t.map(cut),
         }
     }
 }

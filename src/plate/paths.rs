@@ -8,8 +8,8 @@
 //! depend on `k` at fixed indices. Orders beyond the chosen `N` are summed incoherently in
 //! closed form ([`IncoherentTail`]).
 
-use crate::mueller;
-use crate::slab::{SlabOptics, Want};
+use crate::optics::mueller;
+use crate::plate::slab::{SlabOptics, Want};
 use nalgebra::{Matrix2, Matrix4, Vector4};
 use num_complex::Complex64 as C64;
 use std::collections::BTreeMap;
@@ -89,7 +89,7 @@ impl PathExpansion {
     pub fn new(optics: &SlabOptics, n_max: usize, lambda_nm: f64, want: Want) -> Self {
         let m = optics.layer_modes();
         let qs = [-m.down[0].q, -m.down[1].q, m.up[0].q, m.up[1].q];
-        let isotropic = m.down[0].kind == crate::modes::ModeKind::S;
+        let isotropic = m.down[0].kind == crate::optics::modes::ModeKind::S;
         let (t1, r1) = (optics.top.t_above(), optics.top.r_above());
         let (t3, r3) = (optics.top.t_below(), optics.top.r_below());
         let (t2, r2) = (optics.bottom.t_above(), optics.bottom.r_above());
@@ -151,7 +151,7 @@ impl IncoherentTail {
     /// the full coherency of an isotropic layer's s and p, which share their phase.
     fn new(optics: &SlabOptics, state: &State, lambda_nm: f64, want: Want) -> Self {
         let m = optics.layer_modes();
-        let isotropic = m.down[0].kind == crate::modes::ModeKind::S;
+        let isotropic = m.down[0].kind == crate::optics::modes::ModeKind::S;
         let kd = std::f64::consts::TAU * optics.thickness_nm / lambda_nm;
         let att = |q: C64, sign: f64| (-2.0 * sign * kd * q.im).exp();
         let prop = |a: [f64; 2]| -> Matrix4<C64> {

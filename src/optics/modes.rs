@@ -8,8 +8,8 @@
 //! nothing here depends on the wavelength (the seed's "note regarding k").
 
 use crate::cmath::{self, Scalar};
-use crate::fields::{Fields, Wave};
-use crate::medium::Uniaxial;
+use crate::optics::fields::{Fields, Wave};
+use crate::optics::medium::Uniaxial;
 use nalgebra::Vector3;
 use num_complex::Complex64 as C64;
 
@@ -35,7 +35,7 @@ pub enum ModeKind {
 /// Normalisation: s/p modes of isotropic media use the textbook bilinear basis `E_s = ŷ`,
 /// `E_p = k̂ × ŷ` with `k̂ = k/η` (so Fresnel amplitudes are the textbook ones, for complex `η`
 /// too); o/e modes of anisotropic media have unit Hermitian norm `|E| = 1` with the phase of
-/// the closed-form construction of [`crate::fields`] (real for real wave vectors).
+/// the closed-form construction of [`crate::optics::fields`] (real for real wave vectors).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Mode {
     /// Polarisation family.
@@ -285,7 +285,7 @@ pub fn k_max(medium: &Uniaxial) -> (C64, C64) {
 }
 
 /// o and e modes of a (non-isotropic) uniaxial medium (seed eqs. S9-S10), fields from
-/// [`crate::fields`]: in real arithmetic when every wave vector and field is real (lossless
+/// [`crate::optics::fields`]: in real arithmetic when every wave vector and field is real (lossless
 /// medium, real `β`, both waves propagating), else in complex arithmetic.
 #[inline(always)]
 pub fn uniaxial_modes(medium: &Uniaxial, beta: C64) -> ModeSet {

@@ -1,15 +1,16 @@
 //! The surface of a uniaxial crystal under an isotropic exterior, seen from the local shading
 //! frame (Mitsuba's: `z` = normal towards the exterior, the crystal fills `z < 0`).
 //!
-//! This ties [`crate::frame`], [`crate::modes`] and [`crate::interface`] together: it turns a
+//! This ties [`crate::optics::frame`], [`crate::optics::modes`] and [`crate::optics::interface`] together: it turns a
 //! direction of incidence into the incidence parameter `β` and solves the interface with the
 //! exterior as the upper medium and the crystal as the lower one.
 
 use crate::error::{Error, Result};
-use crate::frame::PlaneFrame;
-use crate::interface::Interface;
-use crate::medium::{check_clear_index, Uniaxial};
-use crate::modes::{index_along, k_max, Mode, ModeKind};
+use crate::material::check_clear_index;
+use crate::optics::frame::PlaneFrame;
+use crate::optics::interface::Interface;
+use crate::optics::medium::Uniaxial;
+use crate::optics::modes::{index_along, k_max, Mode, ModeKind};
 use nalgebra::Vector3;
 use num_complex::Complex64 as C64;
 

@@ -1,13 +1,18 @@
-//! A plate whose indices may depend on wavelength: what spectral integration evaluates at
-//! each wavelength it needs.
+//! The plane-parallel plate at one wavelength: the slab's exact optics ([`slab`]), its
+//! path-class expansion ([`paths`]) and the closed form of a lossless isotropic layer
+//! ([`etalon`]); and [`Plate`], a plate whose indices may depend on wavelength, which is what
+//! spectral integration evaluates at each wavelength it needs.
+
+pub mod etalon;
+pub mod paths;
+pub mod slab;
 
 use crate::error::Result;
-use crate::etalon::Etalon;
-use crate::frame::PlaneFrame;
 use crate::material::Material;
-use crate::medium::Uniaxial;
-use crate::slab::{Slab, SlabMueller, Want};
-use crate::spectral::integrate::Output;
+use crate::optics::frame::PlaneFrame;
+use crate::optics::medium::Uniaxial;
+use crate::plate::etalon::Etalon;
+use crate::plate::slab::{Output, Slab, SlabMueller, Want};
 use nalgebra::Vector3;
 use num_complex::Complex64 as C64;
 

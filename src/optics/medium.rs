@@ -5,6 +5,7 @@
 //! imaginary part of its wave vector. The Mitsuba boundary converts once (see `mueller`).
 
 use crate::error::{finite, Error, Result};
+use crate::material::check_index;
 use nalgebra::{Matrix3, Vector3};
 use num_complex::Complex64 as C64;
 
@@ -93,68 +94,6 @@ impl Uniaxial {
         let (io, ie) = (self.eps_o().inv(), self.eps_e().inv());
         Matrix3::identity() * io + a * a.transpose() * (ie - io)
     }
-}
-
-/// Validates the index of an isotropic medium that light arrives from or leaves into: real and
-/// `> 0`. (With absorption there the incident plane wave is inhomogeneous and power fractions
-/// are undefined.)
-pub fn check_clear_index(parameter: &str, eta: C64) -> Result<C64> {
-    check_index(parameter, eta)?;
-    if eta.im != 0.0 {
-        return Err(Error::new(
-            parameter,
-            "must be real: absorbing exterior or exit media are not supported (the incident wave would be inhomogeneous and power fractions undefined)",
-        ));
-    }
-    Ok(eta)
-}
-
-/// Range of the real part of an index (every optical material lies well inside; beyond, the
-/// results leave the range of the renderer's single-precision numbers).
-pub const INDEX_RANGE: (f64, f64) = (1e-3, 1e3);
-/// Largest extinction coefficient `κ` (metals reach ~100 in the infrared).
-pub const KAPPA_MAX: f64 = 1e3;
-
-/// Validates one complex index `n + iκ`: finite, `n` within [`INDEX_RANGE`], `0 <= κ <=`
-/// [`KAPPA_MAX`].
-pub fn check_index(parameter: &str, eta: C64) -> Result<C64> {
-    if !eta.re.is_finite() || !eta.im.is_finite() {
-        return Err(Error::new(parameter, "must be finite"));
-    }
-    if eta.re <= 0.0 {
-        return Err(Error::new(
-            parameter,
-            format!("real part of the index must be > 0, got {}", eta.re),
-        ));
-    }
-    if !(INDEX_RANGE.0..=INDEX_RANGE.1).contains(&eta.re) {
-        return Err(Error::new(
-            parameter,
-            format!(
-                "real part of the index must be within [{}, {}], got {}",
-                INDEX_RANGE.0, INDEX_RANGE.1, eta.re
-            ),
-        ));
-    }
-    if eta.im > KAPPA_MAX {
-        return Err(Error::new(
-            parameter,
-            format!(
-                "extinction coefficient (imaginary part) must be <= {KAPPA_MAX}, got {}",
-                eta.im
-            ),
-        ));
-    }
-    if eta.im < 0.0 {
-        return Err(Error::new(
-            parameter,
-            format!(
-                "extinction coefficient (imaginary part) must be >= 0 in the n + i kappa convention, got {}",
-                eta.im
-            ),
-        ));
-    }
-    Ok(eta)
 }
 
 #[cfg(test)]

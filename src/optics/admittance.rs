@@ -1,5 +1,5 @@
 //! Admittance reduction of the boundary system (seed eqs. S17-S18) when one of the two media is
-//! isotropic: the 4x4 solve of [`crate::interface`] becomes one 2x2 solve plus
+//! isotropic: the 4x4 solve of [`crate::optics::interface`] becomes one 2x2 solve plus
 //! back-substitution, with the same scattering matrix.
 //!
 //! Write the continuity of tangential `ψ = (E_x, E_y, H_x, H_y)` (seed eq. S18) as

@@ -1,8 +1,8 @@
 //! Closed-form Fresnel amplitudes of a planar interface between two isotropic media, in the
-//! core's s/p conventions: the isotropic fast path of [`crate::interface`] and the building
-//! block of [`crate::etalon`].
+//! core's s/p conventions: the isotropic fast path of [`crate::optics::interface`] and the building
+//! block of [`crate::plate::etalon`].
 //!
-//! Conventions of [`crate::modes::isotropic_modes`]: `E_s = ŷ`, `E_p = k̂ × ŷ`, normal
+//! Conventions of [`crate::optics::modes::isotropic_modes`]: `E_s = ŷ`, `E_p = k̂ × ŷ`, normal
 //! components `q = ±w` with `w = sqrt(η² − β²)` the principal root (`Re w ≥ 0`, `Im w ≥ 0`
 //! for the wave that travels or decays upwards). Matching tangential `E` and `H = k × E`
 //! (seed eq. S18 for two isotropic media) gives the textbook amplitudes

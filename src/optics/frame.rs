@@ -1,5 +1,5 @@
 //! The local shading frame (Mitsuba's: `z` = surface normal towards the exterior) and the
-//! plane-of-incidence working frame of [`crate::modes`].
+//! plane-of-incidence working frame of [`crate::optics::modes`].
 
 use nalgebra::Vector3;
 

@@ -2,7 +2,7 @@
 //! S9-S10), in real or complex arithmetic ([`Scalar`]): lossless media with propagating waves
 //! have real fields, and the same steps in `f64` give what the complex ones reduce to.
 //!
-//! Working frame of [`crate::modes`]: `k = (β, 0, q)` in units of `k0`. The displacement of the
+//! Working frame of [`crate::optics::modes`]: `k = (β, 0, q)` in units of `k0`. The displacement of the
 //! o-wave is `D_o ∝ k × A`, that of the e-wave `D_e ∝ k × (k × A)` (both ⟂ k), and
 //! `E = ε⁻¹ D` with `ε⁻¹ = I/ε_o + Δ(1/ε) A Aᵀ` (seed eq. S6); `E` has unit Hermitian norm,
 //! `H = k × E` (seed eq. S2). If `k` is (numerically) along the axis, `k × A` vanishes, o and e

@@ -2,20 +2,20 @@
 //! boundary system (seed eqs. S17-S18) solved once for waves arriving from either side, and the
 //! power ratios (seed eq. S19).
 //!
-//! The upper medium fills `z > 0`, the lower one `z < 0` (working frame of [`crate::modes`]).
+//! The upper medium fills `z > 0`, the lower one `z < 0` (working frame of [`crate::optics::modes`]).
 //! Tangential `E` and `H` are continuous across `z = 0`; writing every field as a sum of modes,
 //! `Ψ₁↓ a + Ψ₁↑ b = Ψ₂↓ c + Ψ₂↑ d` with the known incoming amplitudes `a` (from above) and `d`
 //! (from below). Solving `[Ψ₁↑ −Ψ₂↓] [b; c] = [−Ψ₁↓ Ψ₂↑] [a; d]` gives the full scattering
 //! matrix `S` of the interface: `[b; c] = S [a; d]`. This one solve ([`Interface::from_modes`])
 //! covers iso→aniso, aniso→iso and aniso→aniso interfaces alike; when one side is isotropic,
-//! [`Interface::solve`] reduces it to a 2x2 solve ([`crate::admittance`]) with the same `S`.
+//! [`Interface::solve`] reduces it to a 2x2 solve ([`crate::optics::admittance`]) with the same `S`.
 
-use crate::admittance;
 use crate::cmath;
 use crate::error::{Error, Result};
-use crate::fresnel::Fresnel;
-use crate::medium::Uniaxial;
-use crate::modes::{modes, Mode, ModeKind, ModeSet};
+use crate::optics::admittance;
+use crate::optics::fresnel::Fresnel;
+use crate::optics::medium::Uniaxial;
+use crate::optics::modes::{modes, Mode, ModeKind, ModeSet};
 use nalgebra::{Matrix2, Matrix4};
 use num_complex::Complex64 as C64;
 
@@ -58,7 +58,7 @@ impl Interface {
     }
 
     /// Solves the boundary system for mode sets as [`modes`] gives them: by the admittance
-    /// reduction ([`crate::admittance`], one 2x2 solve) when either side has s/p modes (an
+    /// reduction ([`crate::optics::admittance`], one 2x2 solve) when either side has s/p modes (an
     /// isotropic medium), else by the general 4x4 solve ([`Interface::from_modes`]). The same
     /// scattering matrix either way, to rounding (`tests/interface_fast_path.rs`).
     #[inline]
@@ -184,7 +184,7 @@ fn from_modes_s(upper: &ModeSet, lower: &ModeSet) -> Result<Matrix4<C64>> {
     Ok(s)
 }
 
-/// True for the s/p pair of an isotropic medium ([`crate::modes::isotropic_modes`]): the s
+/// True for the s/p pair of an isotropic medium ([`crate::optics::modes::isotropic_modes`]): the s
 /// mode has only `(E_y, H_x)`, the p mode only `(E_x, H_y)`, which the admittance reduction needs.
 fn is_sp(m: &ModeSet) -> bool {
     let sp = |p: &[Mode; 2]| p[0].kind == ModeKind::S && p[1].kind == ModeKind::P;

@@ -1,21 +1,21 @@
-//! The isotropic fast path of [`crate::sampling::crystal_lobes`]: a lossless isotropic
+//! The isotropic fast path of [`crate::render::crystal::crystal_lobes`]: a lossless isotropic
 //! "crystal" (`η_o = η_e` real) is a dielectric interface, and its lobes follow in closed form
 //! (what Mitsuba's `dielectric` computes, here in this core's frames and conventions).
 //!
 //! Every wave of the event lies in one plane of incidence and its Jones basis is the s/p mode
-//! basis (`x = s`, `y = d × s`, [`crate::lobes`]), so each lobe's Jones matrix is diagonal: the
-//! Fresnel amplitudes of [`crate::fresnel`], flux-normalised (`τ = t √(w_far/w_near)`, the
+//! basis (`x = s`, `y = d × s`, [`crate::optics::lobes`]), so each lobe's Jones matrix is diagonal: the
+//! Fresnel amplitudes of [`crate::optics::fresnel`], flux-normalised (`τ = t √(w_far/w_near)`, the
 //! same factor for s and p in real-index media). Radiance mode needs the transfer from the
 //! source at `wo` into `wi`: for a lossless isotropic interface it is the same Mueller matrix
 //! (reflection: the same angle on the same side; transmission: reciprocity of the
 //! flux-normalised amplitudes, `τ(θ₁ → θ₂) = τ(θ₂ → θ₁)`), scaled by the radiance factor
 //! `(n_wi/n_wo)²` as in the general path.
 
-use crate::frame::PlaneFrame;
-use crate::fresnel::{normal_component, Fresnel};
-use crate::mueller;
-use crate::sampling::{PathLobe, Transport};
-use crate::surface::Surface;
+use crate::optics::frame::PlaneFrame;
+use crate::optics::fresnel::{normal_component, Fresnel};
+use crate::optics::mueller;
+use crate::optics::surface::Surface;
+use crate::render::{PathLobe, Transport};
 use nalgebra::Vector3;
 use num_complex::Complex64 as C64;
 

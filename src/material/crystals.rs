@@ -3,13 +3,13 @@
 //!
 //! Every crystal entry carries the published dispersion formula of one primary
 //! source, its validity range and the full reference; the coefficients are
-//! stored exactly as published (λ in µm, see [`crate::dispersion`]).
+//! stored exactly as published (λ in µm, see [`crate::material::dispersion`]).
 //!
 //! Names are matched case-insensitively after trimming, with `-`, `_` and runs
 //! of whitespace treated as a single space ("Alpha_Quartz" finds
 //! "alpha-quartz").
 
-use crate::dispersion::{Dispersion, Term};
+use crate::material::dispersion::{Dispersion, Term};
 use std::borrow::Cow;
 
 /// A uniaxial crystal: ordinary index `n_o(λ)` and extraordinary index

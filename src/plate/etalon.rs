@@ -3,7 +3,7 @@
 //! for p, and its Mueller matrices follow in closed form, exactly at one wavelength and
 //! exactly over a Gaussian band (no linearisation is needed: the phase is linear in `k`).
 //!
-//! With the interface amplitudes of [`crate::fresnel`] (1: top from above, 3: top from below,
+//! With the interface amplitudes of [`crate::optics::fresnel`] (1: top from above, 3: top from below,
 //! 2: bottom from above), per polarisation `x ∈ {s, p}` and `h = exp(2 i k d w)` the phase of
 //! one internal round trip (`w = sqrt(η² − β²)` of the layer):
 //!
@@ -11,7 +11,7 @@
 //! T_x(k) = τ_x Σ_{m≥0} ρ_x^m h^m            τ_x = t₁ t₂ √(P_exit/P_ext),  ρ_x = r₃ r₂
 //! R_x(k) = r₁ + u_x Σ_{m≥1} ρ_x^{m−1} h^m    u_x = t₁ r₂ t₃
 //! ```
-//! (the slab of [`crate::slab`] with diagonal blocks, up to the common single-pass phase of
+//! (the slab of [`crate::plate::slab`] with diagonal blocks, up to the common single-pass phase of
 //! `T`, which cancels in every power term). The Jones matrices are diagonal, so the Mueller
 //! matrix needs only the coherencies `C_xy = ⟨conj(A_x) A_y⟩` (physics notes §4). Over the
 //! band `G(k; μ, σ)`, a pair of paths whose round-trip counts differ by `Δ` keeps
@@ -28,11 +28,11 @@
 //! thicker than the coherence length only `Δ = 0` survives (the incoherent sum
 //! `T₁T₂/(1 − R₃R₂)` per polarisation).
 
-use crate::fresnel::{normal_component, Fresnel};
-use crate::mueller;
-use crate::slab::{SlabMueller, Want};
-use crate::spectral::integrate::Output;
-use crate::spectral::weights::Gaussian;
+use crate::band::Gaussian;
+use crate::optics::fresnel::{normal_component, Fresnel};
+use crate::optics::mueller;
+use crate::plate::slab::Output;
+use crate::plate::slab::{SlabMueller, Want};
 use num_complex::Complex64 as C64;
 
 /// Series terms below this (relative to the leading term 1) are dropped.

@@ -1,0 +1,157 @@
+//! The lobes of a bulk crystal's surface (reflection, ordinary and extraordinary refraction)
+//! as a path tracer samples them (see [`crate::render`] for the transport modes).
+
+use crate::error::{Error, Result};
+use crate::optics::lobes::{scatter, Event, Lobe};
+use crate::optics::modes::ModeKind;
+use crate::optics::surface::{Incident, Surface};
+use crate::render::isotropic;
+use crate::render::{PathLobe, Transport};
+use nalgebra::Vector3;
+
+/// The forward events of light arriving along `−towards` (exterior, or each crystal mode that
+/// can travel there), with the incident crystal mode.
+fn forward_events(
+    surface: &Surface,
+    towards: Vector3<f64>,
+) -> Result<Vec<(Option<ModeKind>, Event)>> {
+    if towards.z > 0.0 {
+        return Ok(vec![(None, scatter(surface, towards, Incident::Outside)?)]);
+    }
+    let kinds: &[ModeKind] = if surface.crystal.is_isotropic() {
+        &[ModeKind::O]
+    } else {
+        &[ModeKind::O, ModeKind::E]
+    };
+    kinds
+        .iter()
+        .map(|&k| Ok((Some(k), scatter(surface, towards, Incident::Inside(k))?)))
+        .collect()
+}
+
+/// The outgoing lobes of an event whose incident crystal mode is `incident` (`None`: from
+/// the exterior): `(component, crystal mode of the outgoing wave or None if exterior, lobe)`.
+/// Reflections are component 0; a transmission is 1 or 2 by its crystal-side mode.
+fn outgoing(event: &Event, incident: Option<ModeKind>) -> Vec<(usize, Option<ModeKind>, Lobe)> {
+    let by_mode = |m: ModeKind| if m == ModeKind::E { 2 } else { 1 };
+    let mut v = Vec::new();
+    for l in event.reflected.iter().flatten() {
+        v.push((0, incident.map(|_| l.kind), *l));
+    }
+    for l in event.transmitted.iter().flatten() {
+        match incident {
+            None => v.push((by_mode(l.kind), Some(l.kind), *l)),
+            Some(m) => v.push((by_mode(m), None, *l)),
+        }
+    }
+    v
+}
+
+/// Lobes of a bulk crystal surface seen from `wi` (unit, local; `wi.z < 0` is inside). A
+/// lossless isotropic crystal takes the closed form of [`crate::render::isotropic`]. Absorbing
+/// anisotropic crystals are refused (an error naming `kappa`): their per-ray powers are not
+/// defined (see the error message); isotropic absorbing media (metals) are fine.
+pub fn crystal_lobes(
+    surface: &Surface,
+    wi: Vector3<f64>,
+    transport: Transport,
+) -> Result<Vec<PathLobe>> {
+    if !surface.crystal.is_isotropic() && !surface.crystal.is_lossless() {
+        return Err(Error::new(
+            "kappa",
+            "an absorbing birefringent crystal cannot be rendered as a bulk surface: inside it the o and e waves are not power-orthogonal (their fluxes do not add), so the power of each refracted ray is undefined and lobe weights would not conserve energy. Use thinbirefringent for a dichroic plate (its transmission is exact), or kappa_o = kappa_e = 0 here",
+        ));
+    }
+    let Some(wi) = checked_direction(wi)? else {
+        return Ok(Vec::new());
+    };
+    if let Some(lobes) = isotropic::crystal_lobes(surface, wi, transport) {
+        return Ok(lobes);
+    }
+    crystal_lobes_full(surface, wi, transport)
+}
+
+/// `wi` normalised, `None` at exactly grazing incidence (no lobes); an error unless unit.
+fn checked_direction(wi: Vector3<f64>) -> Result<Option<Vector3<f64>>> {
+    if !(wi.iter().all(|x| x.is_finite()) && (wi.norm() - 1.0).abs() < 1e-4) {
+        return Err(Error::new("wi", "must be a unit vector"));
+    }
+    Ok((wi.z != 0.0).then(|| wi.normalize()))
+}
+
+/// [`crystal_lobes`] by the general computation (every case, isotropic ones included): the
+/// reference the isotropic fast path is tested against.
+pub fn crystal_lobes_full(
+    surface: &Surface,
+    wi: Vector3<f64>,
+    transport: Transport,
+) -> Result<Vec<PathLobe>> {
+    let Some(wi) = checked_direction(wi)? else {
+        return Ok(Vec::new());
+    };
+    if wi.z < 0.0 && !surface.crystal.is_lossless() {
+        // Light inside an absorbing bulk medium (a metal-like isotropic one: the only kind
+        // accepted) is absorbed over any path of geometric length, and the power fraction of a
+        // wave incident in a lossy medium has no bound (the flux of the incident and reflected
+        // waves' interference is not counted in either): no lobes, in both transport modes.
+        return Ok(Vec::new());
+    }
+    let mut lobes = Vec::new();
+    for (inc, event) in forward_events(surface, wi)? {
+        for (component, mode, l) in outgoing(&event, inc) {
+            match transport {
+                Transport::Importance => lobes.push(PathLobe::new(
+                    component,
+                    l.direction,
+                    (event.incident_stokes_x, l.stokes_x),
+                    l.mueller,
+                    l.ray_index / event.incident_ray_index,
+                )),
+                Transport::Radiance => {
+                    if let Some(p) = radiance_lobe(surface, wi, inc, l.direction, mode)? {
+                        lobes.push(p);
+                    }
+                }
+            }
+        }
+    }
+    Ok(lobes)
+}
+
+/// The physical transfer from the source at `wo` (found by time reversal) into the wave that
+/// leaves along `wi` in mode `wi_mode` (`None` outside the crystal).
+fn radiance_lobe(
+    surface: &Surface,
+    wi: Vector3<f64>,
+    wi_mode: Option<ModeKind>,
+    wo: Vector3<f64>,
+    wo_mode: Option<ModeKind>,
+) -> Result<Option<PathLobe>> {
+    let incident = match wo_mode {
+        None => Incident::Outside,
+        Some(_) if surface.crystal.is_isotropic() => Incident::Inside(ModeKind::O),
+        Some(m) => Incident::Inside(m),
+    };
+    let event = match scatter(surface, wo, incident) {
+        Ok(e) => e,
+        Err(_) => return Ok(None), // grazing source: carries no power
+    };
+    let source = match incident {
+        Incident::Inside(k) => Some(k),
+        Incident::Outside => None,
+    };
+    let iso = surface.crystal.is_isotropic();
+    let found = outgoing(&event, source)
+        .into_iter()
+        .find(|(_, mode, l)| (l.direction - wi).norm() < 1e-6 && (iso || *mode == wi_mode));
+    Ok(found.map(|(component, _, l)| {
+        let scale = (l.ray_index / event.incident_ray_index).powi(2);
+        PathLobe::new(
+            component,
+            wo,
+            (event.incident_stokes_x, l.stokes_x),
+            l.mueller * scale,
+            event.incident_ray_index / l.ray_index,
+        )
+    }))
+}
