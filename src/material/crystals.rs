@@ -173,9 +173,9 @@ pub static SAPPHIRE: Crystal = Crystal {
 ///
 /// `n_e² = 7.197 + 0.3322/(λ² − 0.0843)`
 ///
-/// Rutile absorbs below ≈ 413 nm: its absorption edge is the direct forbidden gap at
-/// 3.03 eV (J. Pascual, J. Camassel and H. Mathieu, "Fine structure in the intrinsic
-/// absorption edge of TiO₂," Phys. Rev. B 18, 5606 (1978)). The formulas have poles at
+/// Rutile absorbs below ≈ 410 nm: its intrinsic absorption edge, a direct forbidden gap,
+/// lies near 3.03 eV (J. Pascual, J. Camassel and H. Mathieu, "Fine structure in the
+/// intrinsic absorption edge of TiO₂," Phys. Rev. B 18, 5606 (1978)). The formulas have poles at
 /// 283 nm (o) and 290 nm (e) and stay finite above them; between 360 and 430 nm, where
 /// Mitsuba samples but DeVore has no data, the fit is extrapolated without that absorption
 /// (with a warning, see [`crate::material::Material::coverage`]).
@@ -187,7 +187,8 @@ pub static RUTILE: Crystal = Crystal {
     range_nm: (430.0, 1530.0),
     citation: "J. R. DeVore, \"Refractive indices of rutile and sphalerite,\" J. Opt. Soc. Am. \
                41, 416-419 (1951) (room temperature)",
-    beyond_range: "rutile absorbs below about 413 nm (band gap 3.0 eV), which is not modelled",
+    beyond_range:
+        "rutile absorbs below about 410 nm (its band gap, near 3.0 eV), which is not modelled",
 };
 
 /// Magnesium fluoride (MgF₂), positive uniaxial. Dodge (1984), 19 °C,

@@ -11,8 +11,8 @@
 //! absorbing interior medium instead. Keeping the refracted wave would not be well defined
 //! either: its power fraction leaves out the flux of the incident and reflected waves'
 //! interference inside the medium, and the time-reversed (Radiance) weight of a refraction
-//! into it has no bound (about `|n|²/Re(n)⁴` times the Importance weight: 47,000 for silver at
-//! normal incidence). [`opaque`] makes this decision.
+//! into it grows without bound as Re(n) → 0 (about `|n|²/Re(n)⁴` times the Importance
+//! weight: 47,000 for silver at normal incidence). [`opaque`] makes this decision.
 
 use crate::error::{Error, Result};
 use crate::optics::lobes::{scatter, Event, Lobe};
