@@ -6,7 +6,7 @@
 //! naming the parameter; a non-finite result is reported as `BFR_INTERNAL`, never returned.
 
 use crate::error::{Error, Result};
-use crate::material::Material;
+use crate::material::{Material, RENDER_RANGE_NM};
 use crate::optics::medium::Uniaxial;
 use crate::optics::surface::Surface;
 use crate::render::crystal::crystal_lobes;
@@ -171,7 +171,9 @@ fn material_from(desc: &BfrMaterialDesc) -> Result<Material> {
     Material::named(name, desc.kappa_o, desc.kappa_e)
 }
 
-/// Creates a material handle, or returns null and writes a message.
+/// Creates a material handle, or returns null and writes a message. On success the message
+/// is the warning of [`Material::coverage`] over [`RENDER_RANGE_NM`] (the wavelengths the
+/// plugins evaluate: a named crystal whose data do not reach them), empty if none.
 ///
 /// # Safety
 /// `desc` must be null or valid; `message` null or `message_len` writable bytes.
@@ -182,14 +184,23 @@ pub unsafe extern "C" fn bfr_material_new(
     message_len: usize,
 ) -> *mut BfrMaterial {
     let mut out = std::ptr::null_mut();
+    let mut warning = String::new();
     // SAFETY: pointer contracts above.
-    unsafe {
+    let rc = unsafe {
         guarded(message, message_len, || {
             let d = desc.as_ref().ok_or_else(|| null("desc"))?;
-            out = Box::into_raw(Box::new(BfrMaterial(material_from(d)?)));
+            let m = material_from(d)?;
+            warning = m
+                .coverage(RENDER_RANGE_NM.0, RENDER_RANGE_NM.1)?
+                .unwrap_or_default();
+            out = Box::into_raw(Box::new(BfrMaterial(m)));
             Ok(())
         })
     };
+    if rc == BFR_OK {
+        // SAFETY: message validity is the caller's contract.
+        unsafe { write_message(&warning, message, message_len) };
+    }
     out
 }
 

@@ -85,7 +85,9 @@ typedef struct bfr_path_lobe {
  * Two lobes may share a component (reflections inside the crystal). */
 #define BFR_CRYSTAL_LOBES 6
 
-/* Creates a material; NULL on error (message set). Free with bfr_material_free. */
+/* Creates a material; NULL on error (message set). On success message holds a warning, empty
+ * if none: a named crystal whose cited data do not cover 360-830 nm (where Mitsuba samples)
+ * and whose fit is extrapolated there. Free with bfr_material_free. */
 bfr_material *bfr_material_new(const bfr_material_desc *desc, char *message, size_t message_len);
 void bfr_material_free(bfr_material *material);
 

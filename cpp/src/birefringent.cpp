@@ -7,8 +7,9 @@
  * and e rays that can travel along wi); they are sampled in proportion to their weight like the
  * three lobes seen from outside. Which of o/e a ray inside the crystal is lives in its Stokes
  * vector, so double refraction needs a polarized variant; an isotropic material (eta_o ==
- * eta_e, kappa_o == kappa_e) works in every variant. The physics is the core's
- * bfr_crystal_lobes. Parameters: see plugin/README.md.
+ * eta_e, kappa_o == kappa_e) works in every variant. An absorbing (isotropic) material is
+ * opaque, as the core decides: the reflection alone from outside, nothing from inside. The
+ * physics is the core's bfr_crystal_lobes. Parameters: see plugin/README.md.
  */
 #include "common.h"
 

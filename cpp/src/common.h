@@ -106,6 +106,8 @@ inline MaterialPtr make_material(const MaterialParams &p, const char *ClassName)
     bfr_material *m = bfr_material_new(&desc, message, sizeof(message));
     if (!m)
         Throw("%s", core_error(BFR_INVALID, message));
+    if (message[0])
+        Log(Warn, "%s", message);
     return MaterialPtr(m, [](const bfr_material *x) { bfr_material_free(const_cast<bfr_material *>(x)); });
 }
 

@@ -128,6 +128,7 @@ pub fn run(input: &Value) -> Result<Value> {
     out.insert("beta".into(), complex(inc.beta));
     out.insert("k_max".into(), json!({"o": complex(ko), "e": complex(ke)}));
     out.insert("isotropic".into(), json!(m.crystal.is_isotropic()));
+    super::output::insert_warnings(&mut out, &m.warnings);
     Ok(Value::Object(out))
 }
 

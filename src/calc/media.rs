@@ -18,6 +18,8 @@ pub struct Media {
     pub crystal: Uniaxial,
     /// Its indices as functions of wavelength.
     pub material: Material,
+    /// Warnings for the output (a named crystal's fit extrapolated at `wavelength_nm`).
+    pub warnings: Vec<String>,
 }
 
 /// Reads `wavelength_nm`, `ext_ior`, `eta_o`/`eta_e` or `material`, `kappa_o`, `kappa_e` and
@@ -29,7 +31,11 @@ pub fn read(f: &mut Fields) -> Result<Media> {
     }
     let ext = read_ior(f, "ext_ior")?.unwrap_or(C64::new(1.0, 0.0));
     let material = read_material(f)?;
-    let (eta_o, eta_e) = crystal_indices(&material, wavelength_nm)?;
+    let warnings = material
+        .coverage(wavelength_nm, wavelength_nm)?
+        .into_iter()
+        .collect();
+    let (eta_o, eta_e) = material.indices(wavelength_nm, 0.0)?;
     let axis = f.vector3("optic_axis")?;
     let axis = match axis {
         Some(a) => a,
@@ -47,6 +53,7 @@ pub fn read(f: &mut Fields) -> Result<Media> {
         ext,
         crystal,
         material,
+        warnings,
     })
 }
 
@@ -102,21 +109,4 @@ fn read_material(f: &mut Fields) -> Result<Material> {
         (None, Some(_), None) => Err(Error::new("eta_e", "is required with eta_o")),
         (None, None, Some(_)) => Err(Error::new("eta_o", "is required with eta_e")),
     }
-}
-
-/// Indices of `material` at `wavelength_nm`; a named crystal must be within its fit's range.
-fn crystal_indices(material: &Material, wavelength_nm: f64) -> Result<(C64, C64)> {
-    if let Some(name) = material.out_of_range(wavelength_nm, wavelength_nm) {
-        let c = crystals::crystal(name)
-            .map(|c| c.range_nm)
-            .unwrap_or_default();
-        return Err(Error::new(
-            "wavelength_nm",
-            format!(
-                "{wavelength_nm} nm is outside the {}-{} nm range of the dispersion data for {name}",
-                c.0, c.1
-            ),
-        ));
-    }
-    material.indices(wavelength_nm, 0.0)
 }

@@ -4,7 +4,7 @@ use crate::optics::modes::Mode;
 use crate::optics::surface::Solved;
 use nalgebra::Vector3;
 use num_complex::Complex64 as C64;
-use serde_json::{json, Value};
+use serde_json::{json, Map, Value};
 
 /// A JSON number; a non-finite value becomes the marker string [`NON_FINITE`], which
 /// [`super::run_text`] turns into an error (serde_json would silently write `null`).
@@ -38,4 +38,11 @@ pub fn wave(solved: &Solved, mode: &Mode) -> Value {
         "ray_index": mode.ray_index().map(num),
         "flux": num(mode.flux()),
     })
+}
+
+/// Adds the `warnings` array to `out` unless there are none.
+pub fn insert_warnings(out: &mut Map<String, Value>, warnings: &[String]) {
+    if !warnings.is_empty() {
+        out.insert("warnings".into(), json!(warnings));
+    }
 }

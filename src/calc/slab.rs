@@ -24,6 +24,8 @@ pub struct SlabQuery {
     pub frame: crate::optics::frame::PlaneFrame,
     /// Incidence parameter.
     pub beta: C64,
+    /// Warnings for the output (see [`media::Media::warnings`]).
+    pub warnings: Vec<String>,
 }
 
 /// Reads the slab fields (everything but `spectrum`).
@@ -53,6 +55,7 @@ pub fn read(f: &mut Fields) -> Result<SlabQuery> {
         wavelength_nm: m.wavelength_nm,
         frame: inc.frame,
         beta: inc.beta,
+        warnings: m.warnings,
     })
 }
 
@@ -86,6 +89,7 @@ pub fn run_monochromatic(input: &Value, fields: &[&str]) -> Result<Value> {
         json!({"R": matrix(&mr), "T": matrix(&mt)}),
     );
     out.insert("beta".into(), complex(q.beta));
+    super::output::insert_warnings(&mut out, &q.warnings);
     Ok(Value::Object(out))
 }
 

@@ -15,7 +15,7 @@ use nalgebra::{Matrix4, Vector4};
 use serde_json::{json, Map, Value};
 
 /// Visible range of the tabulated weights (nm).
-const RANGE: (f64, f64) = (360.0, 830.0);
+const RANGE: (f64, f64) = crate::material::RENDER_RANGE_NM;
 
 /// Runs `slab` with the `spectrum` object `spec`.
 pub fn run(input: &Value, fields: &[&str], spec: &Value) -> Result<Value> {
@@ -40,7 +40,7 @@ pub fn run(input: &Value, fields: &[&str], spec: &Value) -> Result<Value> {
         }
     }
     let quad = method == "quadrature";
-    let mut warnings = Vec::new();
+    let mut warnings = q.warnings.clone();
     let (names, results): (Vec<String>, Vec<SlabMueller>) =
         match (s.string("weights")?, s.number("bandwidth_nm")?) {
             (Some(w), None) => {
@@ -50,12 +50,7 @@ pub fn run(input: &Value, fields: &[&str], spec: &Value) -> Result<Value> {
                         format!("must be \"srgb-d65\", \"xyz-d65\" or \"xyz-e\", got \"{w}\""),
                     )
                 })?;
-                if let Some(name) = q.plate.material.out_of_range(RANGE.0, RANGE.1) {
-                    warnings.push(format!(
-                        "the dispersion data of {name} does not cover {}-{} nm; extrapolated there",
-                        RANGE.0, RANGE.1
-                    ));
-                }
+                warnings.extend(q.plate.material.coverage(RANGE.0, RANGE.1)?);
                 let step = step.unwrap_or_else(|| auto_step(&q, RANGE.0));
                 let per_channel = if quad {
                     (0..3)
@@ -135,9 +130,7 @@ pub fn run(input: &Value, fields: &[&str], spec: &Value) -> Result<Value> {
     }
     out.insert("channels".into(), json!(names));
     out.insert("method".into(), json!(method));
-    if !warnings.is_empty() {
-        out.insert("warnings".into(), json!(warnings));
-    }
+    super::output::insert_warnings(&mut out, &warnings);
     Ok(Value::Object(out))
 }
 

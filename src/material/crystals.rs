@@ -28,6 +28,9 @@ pub struct Crystal {
     pub range_nm: (f64, f64),
     /// Full reference of the coefficients.
     pub citation: &'static str,
+    /// What is known of the crystal where the renderer's range exceeds `range_nm` and the fit
+    /// is extrapolated (see [`crate::material::Material::coverage`]); empty if nothing to add.
+    pub beyond_range: &'static str,
 }
 
 impl Crystal {
@@ -49,6 +52,15 @@ impl Crystal {
     /// Whether `wavelength_nm` lies inside the fits' validity range.
     pub fn in_range(&self, wavelength_nm: f64) -> bool {
         (self.range_nm.0..=self.range_nm.1).contains(&wavelength_nm)
+    }
+
+    /// The part of `[lo, hi]` nm below and above `range_nm` (each `None` if empty).
+    pub fn uncovered(&self, lo: f64, hi: f64) -> [Option<(f64, f64)>; 2] {
+        let (a, b) = self.range_nm;
+        [
+            (lo < a).then(|| (lo, a.min(hi))),
+            (hi > b).then(|| (b.max(lo), hi)),
+        ]
     }
 }
 
@@ -91,6 +103,7 @@ pub static CALCITE: Crystal = Crystal {
     citation: "G. Ghosh, \"Dispersion-equation coefficients for the refractive index and \
                birefringence of calcite and quartz crystals,\" Opt. Commun. 163, 95-102 (1999), \
                doi:10.1016/S0030-4018(99)00091-7 (room temperature)",
+    beyond_range: "",
 };
 
 /// Crystalline α-quartz (SiO₂), positive uniaxial. Ghosh (1999), room
@@ -116,6 +129,7 @@ pub static QUARTZ: Crystal = Crystal {
     citation: "G. Ghosh, \"Dispersion-equation coefficients for the refractive index and \
                birefringence of calcite and quartz crystals,\" Opt. Commun. 163, 95-102 (1999), \
                doi:10.1016/S0030-4018(99)00091-7 (room temperature)",
+    beyond_range: "",
 };
 
 /// Synthetic sapphire (α-Al₂O₃, corundum), negative uniaxial. Malitson and
@@ -149,6 +163,7 @@ pub static SAPPHIRE: Crystal = Crystal {
                as published in M. J. Dodge, \"Refractive index,\" in Handbook of Laser Science \
                and Technology, Vol. IV, Optical Materials: Part 2 (CRC Press, Boca Raton, 1986), \
                p. 30 (20 °C)",
+    beyond_range: "",
 };
 
 /// Rutile (TiO₂), positive uniaxial. DeVore (1951), room temperature,
@@ -158,8 +173,12 @@ pub static SAPPHIRE: Crystal = Crystal {
 ///
 /// `n_e² = 7.197 + 0.3322/(λ² − 0.0843)`
 ///
-/// Rutile absorbs below ≈ 410 nm (band gap ≈ 3 eV); the formulas have poles at
-/// 283 nm (o) and 290 nm (e) and stay finite above them.
+/// Rutile absorbs below ≈ 410 nm: its intrinsic absorption edge, a direct forbidden gap,
+/// lies near 3.03 eV (J. Pascual, J. Camassel and H. Mathieu, "Fine structure in the
+/// intrinsic absorption edge of TiO₂," Phys. Rev. B 18, 5606 (1978)). The formulas have poles at
+/// 283 nm (o) and 290 nm (e) and stay finite above them; between 360 and 430 nm, where
+/// Mitsuba samples but DeVore has no data, the fit is extrapolated without that absorption
+/// (with a warning, see [`crate::material::Material::coverage`]).
 pub static RUTILE: Crystal = Crystal {
     name: "rutile",
     aliases: &["tio2"],
@@ -168,6 +187,8 @@ pub static RUTILE: Crystal = Crystal {
     range_nm: (430.0, 1530.0),
     citation: "J. R. DeVore, \"Refractive indices of rutile and sphalerite,\" J. Opt. Soc. Am. \
                41, 416-419 (1951) (room temperature)",
+    beyond_range:
+        "rutile absorbs below about 410 nm (its band gap, near 3.0 eV), which is not modelled",
 };
 
 /// Magnesium fluoride (MgF₂), positive uniaxial. Dodge (1984), 19 °C,
@@ -198,6 +219,7 @@ pub static MAGNESIUM_FLUORIDE: Crystal = Crystal {
     range_nm: (200.0, 7000.0),
     citation: "M. J. Dodge, \"Refractive properties of magnesium fluoride,\" Appl. Opt. 23, \
                1980-1985 (1984) (19 °C)",
+    beyond_range: "",
 };
 
 /// Congruently grown lithium niobate (LiNbO₃), negative uniaxial. Zelmon,
@@ -230,6 +252,7 @@ pub static LITHIUM_NIOBATE: Crystal = Crystal {
                coefficients for congruently grown lithium niobate and 5 mol.% magnesium \
                oxide-doped lithium niobate,\" J. Opt. Soc. Am. B 14, 3319-3322 (1997) \
                (congruent LiNbO3, 21 °C)",
+    beyond_range: "",
 };
 
 /// β-barium borate (β-BaB₂O₄, BBO), negative uniaxial. Eimerl et al. (1987),
@@ -253,6 +276,7 @@ pub static BETA_BARIUM_BORATE: Crystal = Crystal {
     citation: "D. Eimerl, L. Davis, S. Velsko, E. K. Graham, and A. Zalkin, \"Optical, \
                mechanical, and thermal properties of barium borate,\" J. Appl. Phys. 62, \
                1968-1983 (1987) (room temperature)",
+    beyond_range: "",
 };
 
 /// Potassium dihydrogen phosphate (KH₂PO₄, KDP), negative uniaxial. Zernike
@@ -276,6 +300,7 @@ pub static KDP: Crystal = Crystal {
     citation: "F. Zernike, Jr., \"Refractive indices of ammonium dihydrogen phosphate and \
                potassium dihydrogen phosphate between 2000 Å and 1.5 µ,\" J. Opt. Soc. Am. 54, \
                1215 (1964) (24.8 °C)",
+    beyond_range: "",
 };
 
 static CRYSTALS: [&Crystal; 8] = [

@@ -11,6 +11,10 @@ use num_complex::Complex64 as C64;
 /// electrodynamics, so anything beyond is outside the model (and outside f64's comfort).
 pub const WAVELENGTH_RANGE: (f64, f64) = (1.0, 1e6);
 
+/// Wavelengths (nm) a renderer evaluates materials over: Mitsuba's spectral variants sample
+/// 360-830 nm, the range of the CIE tables (which the RGB integration covers too).
+pub const RENDER_RANGE_NM: (f64, f64) = (360.0, 830.0);
+
 /// Fails (naming `wavelength_nm`) outside [`WAVELENGTH_RANGE`] or for NaN.
 pub fn check_wavelength(lambda_nm: f64) -> Result<()> {
     if (WAVELENGTH_RANGE.0..=WAVELENGTH_RANGE.1).contains(&lambda_nm) {
@@ -44,7 +48,7 @@ pub enum Index {
 
 impl Index {
     /// The complex index at `lambda_nm`. Crystal fits are evaluated outside their range too
-    /// (see [`Material::out_of_range`]).
+    /// (what callers accept there is [`Material::coverage`]).
     pub fn at(&self, lambda_nm: f64) -> C64 {
         match *self {
             Index::Constant(n) => n,
@@ -140,16 +144,65 @@ impl Material {
         self.eta_o.is_dispersive() || self.eta_e.is_dispersive()
     }
 
-    /// The crystal whose dispersion fit does not cover `[lo, hi]` nm, if any.
-    pub fn out_of_range(&self, lo: f64, hi: f64) -> Option<&'static str> {
-        [self.eta_o, self.eta_e].iter().find_map(|i| match i {
-            Index::Crystal { crystal, .. }
-                if crystal.range_nm.0 > lo || crystal.range_nm.1 < hi =>
-            {
-                Some(crystal.name)
+    /// The named crystals of this material (each once).
+    fn crystals(&self) -> Vec<&'static Crystal> {
+        let mut v: Vec<&'static Crystal> = Vec::new();
+        for i in [self.eta_o, self.eta_e] {
+            if let Index::Crystal { crystal, .. } = i {
+                if !v.iter().any(|c| std::ptr::eq(*c, crystal)) {
+                    v.push(crystal);
+                }
             }
-            _ => None,
-        })
+        }
+        v
+    }
+
+    /// The rule for wavelengths a named crystal's cited data do not cover, for a caller that
+    /// evaluates the material over `[lo, hi]` nm (the calculator: its one wavelength; the
+    /// plugins, at load: [`RENDER_RANGE_NM`]). This is the only place it is decided:
+    ///
+    /// - inside the data's range ([`Crystal::range_nm`]): `Ok(None)`;
+    /// - partly outside it but within [`RENDER_RANGE_NM`], where every catalogued fit is
+    ///   finite, pole-free and of normal dispersion (tested in `crystals`): the fit is
+    ///   extrapolated, `Ok(Some(warning))` with the data's range and what is known there;
+    /// - beyond both: an error naming `wavelength_nm` and the data's range.
+    pub fn coverage(&self, lo: f64, hi: f64) -> Result<Option<String>> {
+        let mut warnings = Vec::new();
+        for c in self.crystals() {
+            let (a, b) = c.range_nm;
+            let (r0, r1) = RENDER_RANGE_NM;
+            for (u0, u1) in c.uncovered(lo, hi).into_iter().flatten() {
+                if u0 < r0 || u1 > r1 {
+                    let at = if lo == hi {
+                        format!("{lo} nm is")
+                    } else {
+                        format!("{lo}-{hi} nm are")
+                    };
+                    return Err(Error::new(
+                        "wavelength_nm",
+                        format!(
+                            "{at} outside the {a}-{b} nm range of the dispersion data for {} (extrapolated only within {r0}-{r1} nm, where Mitsuba samples)",
+                            c.name
+                        ),
+                    ));
+                }
+                let span = if u0 == u1 {
+                    format!("{u0} nm")
+                } else {
+                    format!("{u0}-{u1} nm")
+                };
+                let note = if c.beyond_range.is_empty() {
+                    String::new()
+                } else {
+                    format!("; {}", c.beyond_range)
+                };
+                warnings.push(format!(
+                    "the dispersion data for {} cover {a}-{b} nm: its fit is extrapolated at {span}{note}",
+                    c.name
+                ));
+            }
+        }
+        Ok((!warnings.is_empty()).then(|| warnings.join("; ")))
     }
 }
 
