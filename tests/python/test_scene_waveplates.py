@@ -9,9 +9,12 @@ Three references, each independent of the renderer:
    163, 95 (1999)) evaluated here: t = t12 t21 e^{i phi} / (1 - r^2 e^{2 i phi}), phi = 2 pi n d /
    lambda;
 3. the ideal retarder of retardance 2 pi (n_e - n_o) d / lambda (= 90 resp. 180 degrees by
-   design), which the real plate matches only up to its multiple reflections: the test bounds the
-   difference by the largest deviation the etalon can cause for these indices (scanning the
-   common etalon phase over a full period at fixed retardance).
+   design), which the real plate matches only up to its faces (the o/e difference of their
+   Fresnel transmission, and the multiple reflections): the test bounds the difference by the
+   largest deviation the etalon can cause for these indices (scanning the common etalon phase
+   over a full period at fixed retardance).
+The render must match reference 2 closely enough that the same plate without its multiple
+reflections (one pass through each face) fails.
 Stokes frame (stokes integrator, camera looking down -z with up +y): x = image right, y = image
 up, light travelling towards the camera; Mitsuba's time convention exp(+i w t) (the calculator's
 and Born & Wolf's exp(-i w t) amplitudes are conjugated), S3 = 2 Im(Ex* Ey).
