@@ -19,9 +19,11 @@
 #   make fuzz     make setup, then a long fuzz campaign: every libFuzzer target of tests/fuzz/
 #                 (the C ABI, the JSON calculator) for FUZZ_SECONDS each (default 600), then the
 #                 plugin-parameter fuzzer for FUZZ_SECONDS; FUZZ_STRICT=1 also fails on soft
-#                 findings (an internal-error status, a power fraction > 1; see tests/fuzz/run.sh)
-#   make fuzz-ci  (part of test) the same for FUZZ_CI_SECONDS per libFuzzer target (10) and
-#                 PLUGIN_FUZZ_CI_SECONDS (20) for the plugin fuzzer
+#                 findings (the core's internal error, a power fraction > 1; see
+#                 tests/fuzz/run.sh), FUZZ_EXHAUSTIVE=1 on slow inputs too (one process)
+#   make fuzz-ci  (part of test) the same, strict (FUZZ_STRICT=1: soft findings fail), for
+#                 FUZZ_CI_SECONDS per libFuzzer target (10) and PLUGIN_FUZZ_CI_SECONDS (20)
+#                 for the plugin fuzzer
 #   make bench    make setup, then the core benchmark on one core (taskset -c 0) and its plot:
 #                 bench/out/core.json, bench/out/core_error_vs_time.png (several minutes), then
 #                 make bench-scenes
@@ -165,7 +167,10 @@ test-python: plugin
 # target/fuzz/ and runs each for the given seconds with a fixed seed; crashing inputs are kept
 # in target/fuzz/artifacts/. tests/fuzz/plugin_fuzz.py fuzzes the plugin parameters through
 # mi.load_dict in every supported variant, one worker subprocess at a time (a segfault is a
-# finding, its input kept in target/fuzz/plugin/). Both print executions and exit 1 on a crash.
+# finding, its input kept in target/fuzz/plugin/). Both print executions and exit 1 on a crash;
+# fuzz-ci (make test) also on a soft finding: the core's internal error (a panic it caught, a
+# non-finite result it refused), which reaches the renderer only as a warning and no light, or a
+# power fraction above 1.
 FUZZ_SECONDS ?= 600
 FUZZ_CI_SECONDS ?= 10
 PLUGIN_FUZZ_CI_SECONDS ?= 20
@@ -175,8 +180,8 @@ fuzz: setup
 	$(VPY) tests/fuzz/plugin_fuzz.py --seconds $(FUZZ_SECONDS) $(if $(filter 1,$(FUZZ_STRICT)),--strict)
 
 fuzz-ci: plugin
-	CARGO=$(CARGO) tests/fuzz/run.sh $(FUZZ_CI_SECONDS)
-	$(VPY) tests/fuzz/plugin_fuzz.py --seconds $(PLUGIN_FUZZ_CI_SECONDS)
+	FUZZ_STRICT=1 CARGO=$(CARGO) tests/fuzz/run.sh $(FUZZ_CI_SECONDS)
+	$(VPY) tests/fuzz/plugin_fuzz.py --seconds $(PLUGIN_FUZZ_CI_SECONDS) --strict
 
 ## ---- benchmark ------------------------------------------------------------------------
 

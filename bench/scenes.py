@@ -43,10 +43,11 @@ of the machine; wall time of ``mi.render`` only, the scene loaded and rendered o
 
 3. **Shortcuts**: the core-level ratios of ``examples/bench_shortcuts.rs`` (read from
    ``bench/out/shortcuts.json``, which ``make bench-scenes`` writes first) plus the scene-level
-   isotropic ratios of part 2.
+   isotropic ratios of part 2: every case (``shortcut_cases``) and one headline case each
+   (``shortcuts``).
 
 Writes ``bench/results.json`` (the summary: ``overhead_vs_mitsuba``,
-``analytic_speedup_at_equal_error``, ``shortcuts``, the machine and the date),
+``analytic_speedup_at_equal_error``, ``shortcuts``, ``shortcut_cases``, the machine and the date),
 ``bench/out/scenes.json`` (every measurement) and one PNG per scene
 (``bench/out/error_vs_time-<scene>.png``). ``bench/readme.py`` turns the results into the README
 section.
@@ -467,6 +468,11 @@ def main() -> int:
     shortcuts = dict(core_shortcuts["headline"]) if core_shortcuts else {}
     shortcuts["isotropic_fast_path_scene_thin"] = polarized["isotropic_fast_path_thin"]
     shortcuts["isotropic_fast_path_scene_bulk"] = polarized["isotropic_fast_path_bulk"]
+    # Every measured case of every shortcut (the headline above is one chosen case each).
+    shortcut_cases = ({k: c["ratio"] for k, c in core_shortcuts["cases"].items()}
+                      if core_shortcuts else {})
+    shortcut_cases["isotropic_fast_path/scene_thin"] = polarized["isotropic_fast_path_thin"]
+    shortcut_cases["isotropic_fast_path/scene_bulk"] = polarized["isotropic_fast_path_bulk"]
     import mitsuba as mi
 
     results = {
@@ -481,6 +487,7 @@ def main() -> int:
         "analytic_speedup_at_equal_error": {n: r["headline"]["ratio"] for n, r in scenes.items()},
         "equal_error_detail": {n: r["headline"] for n, r in scenes.items()},
         "shortcuts": shortcuts,
+        "shortcut_cases": shortcut_cases,
         "settings": {"overhead": {"size": OVERHEAD_SIZE, "spp": OVERHEAD_SPP,
                                   "repeats": a.repeats, "integrator": "path, max_depth 8"},
                      "reference_spp": REFERENCE_SPP, "spp": SPP, "scene_budgets": SCENE_BUDGETS,

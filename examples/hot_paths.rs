@@ -12,7 +12,8 @@
 //! exact / 4 nm band / sRGB, quartz 20 um, 60 um, calcite 1 mm and a 3 mm photoelastic-like
 //! plate in a 4 nm band, a 0.5 um lithium niobate film in sRGB: in air, and as in the thin_film
 //! scene, x-cut on black silica, `plate_film_scene_rgb`). Directions: 64 on a spiral up
-//! to `THETA_MAX` degrees from the normal (default 80).
+//! to `THETA_MAX` degrees from the normal (default 45, the directions plugin/README.md's counts
+//! are quoted for).
 
 use birefringent::material::Material;
 use birefringent::optics::interface::Interface;
@@ -32,7 +33,7 @@ fn dirs(n: usize) -> Vec<Vector3<f64>> {
             let max: f64 = std::env::var("THETA_MAX")
                 .ok()
                 .and_then(|v| v.parse().ok())
-                .unwrap_or(80.0);
+                .unwrap_or(45.0);
             let t = max.to_radians() * (i as f64 + 0.5) / n as f64;
             let p = 2.399963 * i as f64;
             Vector3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos())

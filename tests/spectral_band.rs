@@ -1,6 +1,7 @@
 //! Closed-form band integration against dense quadrature of the exact slab, over Gaussian bands
-//! (the same weight on both sides, so only the closed form is tested), and the shortcuts
-//! against the full computation.
+//! (the closed form takes `narrow_band`, the quadrature the band as documented, written out in
+//! `tests/common/band.rs`: so both the integration and the meaning of the width are tested),
+//! and the shortcuts against the full computation.
 
 use birefringent::band::narrow_band;
 use birefringent::material::Material;
@@ -13,18 +14,8 @@ use birefringent::C64;
 use nalgebra::{Matrix4, Vector3};
 
 mod common;
+use common::band::band_weight;
 use common::Rng;
-
-/// The Gaussian band of `narrow_band(center, fwhm)` as a weight per nm: G(k) |dk/dλ|.
-fn band_weight(center: f64, fwhm: f64) -> impl Fn(f64) -> f64 {
-    let g = narrow_band(center, fwhm);
-    move |lambda: f64| {
-        let k = std::f64::consts::TAU / lambda;
-        let z = (k - g.mu) / g.sigma;
-        (-0.5 * z * z).exp() / (g.sigma * std::f64::consts::TAU.sqrt()) * std::f64::consts::TAU
-            / (lambda * lambda)
-    }
-}
 
 fn random_plate(rng: &mut Rng) -> Plate {
     let material = match rng.index(5) {

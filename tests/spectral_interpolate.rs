@@ -4,7 +4,7 @@
 use birefringent::material::Material;
 use birefringent::optics::frame::PlaneFrame;
 use birefringent::plate::slab::Want;
-use birefringent::spectral::interpolate::{BlockInterpolant, TOLERANCE};
+use birefringent::spectral::interpolate::BlockInterpolant;
 use birefringent::C64;
 
 mod common;
@@ -50,9 +50,11 @@ fn interpolated_blocks_match_the_exact_plate_across_the_visible() {
         }
     }
     println!("interpolated blocks: {accepted} plates accepted, {refused} refused; worst Mueller difference {worst:e}");
-    // Accepted interpolants reproduce the blocks to TOLERANCE at their check points; between
-    // them the smooth Sellmeier dispersion keeps the error of the same order (the phases k d q
-    // of plates up to 10 um amplify a q error by k d <= 170).
-    assert!(worst < 1e3 * TOLERANCE, "{worst:e}");
+    // Accepted interpolants reproduce the blocks to TOLERANCE (1e-10) at their check points;
+    // between them the smooth Sellmeier dispersion keeps the error of the same order, amplified
+    // in the Mueller matrices by the phases k d q of plates up to 10 um (k d <= 170). Measured
+    // worst 9.7e-10 (this code and these 200 plates); bound 3e-9, a factor 3 above it, a fixed
+    // number (re-measure when the interpolation or its TOLERANCE changes).
+    assert!(worst < 3e-9, "{worst:e}");
     assert!(accepted > 150, "{accepted} accepted");
 }

@@ -8,7 +8,7 @@ use birefringent::plate::slab::Output;
 use birefringent::plate::slab::Want;
 use birefringent::plate::Plate;
 use birefringent::spectral::hermite;
-use birefringent::spectral::shared::{self, support, TOLERANCE};
+use birefringent::spectral::shared::{self, support};
 use birefringent::spectral::weights::{gaussians, WeightSet};
 use birefringent::C64;
 use nalgebra::Matrix4;
@@ -98,10 +98,11 @@ fn shared_rule_matches_a_dense_rule_of_the_exact_plate() {
         point_counts[point_counts.len() / 2],
         point_counts.last().unwrap()
     );
-    // The rule holds each oscillation's error below TOLERANCE (1e-5); a few oscillations and the
-    // interpolated blocks (checked to 1e-10) add up to at most a few TOLERANCE (the amplitude
-    // model is conservative: measured worst 5.7e-7). The composite Gauss-Legendre rule of 8
-    // panels the shared quadrature used before gave ~1e-3 here on films below 100 nm.
-    assert!(worst < 10.0 * TOLERANCE, "{worst:e}");
+    // The rule holds each oscillation's error below its TOLERANCE (1e-5), with a conservative
+    // amplitude model: measured worst 5.7e-7 (this code and these 120 plates); bound 2e-6, a
+    // factor 3.5 above it, a fixed number (a rule that only met its own TOLERANCE, or a looser
+    // TOLERANCE, fails here: re-measure when the rule changes). The composite Gauss-Legendre
+    // rule of 8 panels the shared quadrature used before gave ~1e-3 here on films below 100 nm.
+    assert!(worst < 2e-6, "{worst:e}");
     assert!(planned >= 80, "{planned} planned");
 }

@@ -1,7 +1,8 @@
-//! Shared helpers of the integration tests: a seeded RNG and the independent Berreman 4x4
-//! reference ([`berreman`]).
+//! Shared helpers of the integration tests: a seeded RNG, the independent Berreman 4x4
+//! reference ([`berreman`]) and the documented meaning of a band's width ([`band`]).
 #![allow(dead_code)]
 
+pub mod band;
 pub mod berreman;
 
 use nalgebra::Vector3;

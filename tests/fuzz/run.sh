@@ -20,7 +20,9 @@
 # Inputs that break only the soft contract (the core's *internal* error, BFR_INTERNAL or "a bug:
 # please report the input": a clean error status, no non-finite number handed out, but a core
 # defect; or a finite power fraction above 1) are kept in target/fuzz/findings/TARGET/ and
-# listed; FUZZ_STRICT=1 turns them into crashes.
+# listed; FUZZ_STRICT=1 (which `make test` sets) turns them into crashes: the run fails and the
+# input is kept in target/fuzz/artifacts/TARGET/. FUZZ_EXHAUSTIVE=1 runs one process in which a
+# timeout fails too, and skips nothing (see the libFuzzer options below).
 # libFuzzer's seed is fixed (FUZZ_SEED, default 1) so that runs are repeatable up to timing.
 # Prints the executions of each target and their total.
 set -euo pipefail
@@ -70,8 +72,9 @@ for t in "${targets[@]}"; do
   # large index takes seconds to minutes: reported to the lead), so by default libFuzzer runs
   # in fork mode, where an input running longer than FUZZ_TIMEOUT (10 s) is kept as a
   # timeout-* artifact and listed, and fuzzing goes on; crashes and memory blow-ups stop the
-  # run and fail. FUZZ_STRICT=1: one process, and a timeout (FUZZ_TIMEOUT, 60 s) fails too.
-  if [ "${FUZZ_STRICT:-0}" = 1 ]; then
+  # run and fail (with FUZZ_STRICT=1 a soft finding is such a crash). FUZZ_EXHAUSTIVE=1: one
+  # process, and a timeout (FUZZ_TIMEOUT, 60 s) fails too.
+  if [ "${FUZZ_EXHAUSTIVE:-0}" = 1 ]; then
     mode=(-timeout="${FUZZ_TIMEOUT:-60}" -print_final_stats=1)
   else
     mode=(-fork=1 -ignore_timeouts=1 -ignore_ooms=0 -ignore_crashes=0 -timeout_exitcode=0

@@ -405,18 +405,19 @@ pub fn soft_finding(what: &str) {
     });
 }
 
-/// True when `FUZZ_STRICT=1`: soft findings fail too, and nothing is skipped.
-pub fn strict() -> bool {
-    std::env::var("FUZZ_STRICT").is_ok_and(|v| v == "1")
+/// True when `FUZZ_EXHAUSTIVE=1`: nothing is skipped (tests/fuzz/run.sh then also runs one
+/// process in which a timeout fails). Soft findings fail with `FUZZ_STRICT=1`, independently.
+pub fn exhaustive() -> bool {
+    std::env::var("FUZZ_EXHAUSTIVE").is_ok_and(|v| v == "1")
 }
 
-/// Calculator documents the bounded runs skip (unless [`strict`]): the dense-quadrature
+/// Calculator documents the bounded runs skip (unless [`exhaustive`]): the dense-quadrature
 /// reference (`"method": "quadrature"`) costs one exact plate per node; the core accepts up to
 /// 1e7 nodes (a minute), so more than 1e6 nodes is skipped to keep the runs exploring. (The
 /// earlier skips of extreme magnitudes and of bands wider than half their wavelength are gone:
 /// the core now refuses such inputs with a clear error.)
 pub fn known_calc(text: &str) -> bool {
-    if strict() {
+    if exhaustive() {
         return false;
     }
     let Ok(v) = serde_json::from_str::<Value>(text) else {
