@@ -6,7 +6,8 @@
 #                 and Figure 1 of the paper's supplemental to out/fig1.png and out/fig1.json
 #   make gallery  make setup, then renders every scene of scenes/ at gallery size into
 #                 out/gallery/ and the contact sheet scenes/gallery.png (several minutes)
-#   make test     builds everything (make setup), then runs every test: cargo's, then pytest's
+#   make test     builds everything (make setup), then runs every test: cargo fmt --check, cargo
+#                 clippy (warnings are errors), cargo's tests, then pytest's, then make fuzz-ci
 #   make setup    cargo build --release, the virtualenv .venv/ from requirements.txt, the
 #                 Mitsuba plugin library (cpp/) and the mitsuba_birefringent package in .venv/;
 #                 idempotent, and quick when nothing changed
@@ -157,6 +158,8 @@ gallery: setup
 ## ---- tests ------------------------------------------------------------------------------
 
 test: setup
+	$(MAKE) --no-print-directory fmt
+	$(MAKE) --no-print-directory lint
 	$(MAKE) --no-print-directory test-rust
 	$(MAKE) --no-print-directory test-python
 	$(MAKE) --no-print-directory fuzz-ci
