@@ -108,13 +108,14 @@ $(VENV_STAMP): requirements.txt
 	@touch $@
 
 # The plugin library and the package: `import mitsuba; import mitsuba_birefringent` in .venv/
-# registers the BSDFs `thinbirefringent` and `birefringent`. The package is installed editable
-# (a .pth file pointing at plugin/, the metadata and the command mitsuba-birefringent) when the
-# packaging changes; every run then rebuilds the library through the build backend, i.e. with the
-# same command as `pip install .` (no network).
+# registers the BSDFs `thinbirefringent` and `birefringent`. Every run builds the library through
+# the build backend, i.e. with the same command as `pip install .`; the package is installed
+# editable (a .pth file pointing at plugin/, the metadata and the command mitsuba-birefringent)
+# when the packaging changes, which runs the same build again (up to date by then). No network.
 EDITABLE_STAMP := $(VENV)/.editable-stamp
-plugin: build venv $(EDITABLE_STAMP)
+plugin: build venv
 	@$(VPY) build_backend/birefringent_backend.py
+	@$(MAKE) --no-print-directory $(EDITABLE_STAMP)
 
 $(EDITABLE_STAMP): pyproject.toml Cargo.toml build_backend/birefringent_backend.py $(VENV_STAMP)
 	$(VPY) -m pip install $(PIP_FLAGS) --no-build-isolation --no-deps --no-index -e .
