@@ -6,11 +6,15 @@
 #                 and Figure 1 of the paper's supplemental to out/fig1.png and out/fig1.json
 #   make gallery  make setup, then renders every scene of scenes/ at gallery size into
 #                 out/gallery/ and the contact sheet scenes/gallery.png (several minutes)
-#   make test     builds everything (make setup), then runs every test: cargo's, then pytest's
+#   make test     builds everything (make setup), then runs every test: cargo fmt --check, cargo
+#                 clippy (warnings are errors), cargo's tests, then pytest's, then make fuzz-ci
 #   make setup    cargo build --release, the virtualenv .venv/ from requirements.txt, the
 #                 Mitsuba plugin library (cpp/) and the mitsuba_birefringent package in .venv/;
 #                 idempotent, and quick when nothing changed
-#   make plugin   (part of setup) the plugin library plugin/mitsuba_birefringent/*.so and the .pth
+#   make plugin   (part of setup) the plugin library plugin/mitsuba_birefringent/*.so and the
+#                 package in .venv/ (an editable install: `pip install -e .`, the same build as
+#                 `pip install .` and `pip wheel .`, see pyproject.toml), with its command
+#                 mitsuba-birefringent
 #   make fmt      cargo fmt --check
 #   make lint     cargo clippy on all targets, warnings are errors
 #   make clean    removes build outputs (target/, out/, Python caches, the scenes' generated
@@ -51,8 +55,11 @@ PYTESTS := tests/python
 PIP_FLAGS := --disable-pip-version-check --no-input --progress-bar off
 
 # The Mitsuba plugin library: the C++ shim (cpp/src/*.cpp) + the Rust core's static library,
-# compiled against the headers of the mitsuba/drjit/nanobind wheels in .venv/, written into the
-# Python package plugin/mitsuba_birefringent/ (which .venv/ imports through a .pth file).
+# compiled against the headers of the mitsuba/drjit/nanobind wheels in SITE, written into the
+# Python package plugin/mitsuba_birefringent/. The Python build backend
+# (build_backend/birefringent_backend.py, BUILD_COMMAND) builds it with `make plugin-lib`, passing
+# the site-packages of its build environment as SITE (.venv/'s for make setup), VENV_STAMP= (no
+# virtualenv is needed) and CPP_OBJ_DIR=target/cpp/<versions of the headers' packages>.
 RUST_LIB := target/release/libbirefringent.a
 CPP_OBJ_DIR := target/cpp
 CPP_SRCS := $(wildcard cpp/src/*.cpp)
@@ -61,19 +68,20 @@ CPP_HDRS := $(wildcard cpp/src/*.h) cpp/include/birefringent.h
 PLUGIN_SO := plugin/mitsuba_birefringent/libmitsuba_birefringent.so
 # site-packages of .venv/ (evaluated when used: the venv may not exist yet when make starts)
 SITE = $(shell $(VPY) -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')
-# These flags must match the PyPI wheels (see the notes on building against Mitsuba): above all
-# -march=ivybridge, which sets Dr.Jit's array padding and so the layout of Mitsuba's structs.
+# These flags must match the PyPI wheels (see docs/building.md): above all -march=ivybridge,
+# which sets Dr.Jit's array padding and so the layout of Mitsuba's structs. The RUNPATH finds
+# libmitsuba and libdrjit-core beside the package in site-packages (the wheel's layout).
 MI_CXXFLAGS = -std=c++17 -O2 -fPIC -fvisibility=hidden -march=ivybridge -ffp-contract=fast \
   -fno-math-errno -DNDEBUG -DMI_ENABLE_LLVM=1 -DMI_ENABLE_CUDA=1 -DMI_ENABLE_EMBREE=1 \
   -DMI_ENABLE_AUTODIFF=1 -Wall -Icpp/include -isystem $(SITE)/mitsuba/include \
   -isystem $(SITE)/drjit/include -isystem $(SITE)/nanobind/include \
   -isystem $(SITE)/nanobind/ext/robin_map/include
 MI_LDFLAGS = -shared -L$(SITE)/mitsuba -lmitsuba -L$(SITE)/drjit -ldrjit-core \
-  -Wl,-rpath,$(SITE)/mitsuba -Wl,-rpath,$(SITE)/drjit \
+  -Wl,-rpath,'$$ORIGIN/../mitsuba' -Wl,-rpath,'$$ORIGIN/../drjit' \
   -Wl,--exclude-libs,ALL -Wl,--gc-sections -Wl,--strip-debug -Wl,--no-undefined \
   -lpthread -ldl -lm
 
-.PHONY: help setup build venv plugin render gallery test test-rust test-python fuzz fuzz-ci bench bench-scenes fmt lint clean distclean
+.PHONY: help setup build venv plugin plugin-lib render gallery test test-rust test-python fuzz fuzz-ci bench bench-scenes fmt lint clean distclean
 
 help:
 	@sed -n '3,/^$$/s/^# \{0,1\}//p' $(firstword $(MAKEFILE_LIST))
@@ -102,14 +110,23 @@ $(VENV_STAMP): requirements.txt
 	@touch $@
 
 # The plugin library and the package: `import mitsuba; import mitsuba_birefringent` in .venv/
-# registers the BSDFs `thinbirefringent` and `birefringent`. The package is installed as a .pth
-# file pointing at plugin/ (no build step, no network; rewritten if the checkout moves).
+# registers the BSDFs `thinbirefringent` and `birefringent`. Every run builds the library through
+# the build backend, i.e. with the same command as `pip install .`; the package is installed
+# editable (a .pth file pointing at plugin/, the metadata and the command mitsuba-birefringent)
+# when the packaging changes, which runs the same build again (up to date by then). No network.
+EDITABLE_STAMP := $(VENV)/.editable-stamp
 plugin: build venv
+	@$(VPY) build_backend/birefringent_backend.py
+	@$(MAKE) --no-print-directory $(EDITABLE_STAMP)
+
+$(EDITABLE_STAMP): pyproject.toml Cargo.toml build_backend/birefringent_backend.py $(VENV_STAMP)
+	$(VPY) -m pip install $(PIP_FLAGS) --no-build-isolation --no-deps --no-index -e .
+	@touch $@
+
+# The library alone, against the packages in SITE (the build backend's command; see above).
+plugin-lib:
+	$(CARGO) build --release --lib
 	@$(MAKE) --no-print-directory $(PLUGIN_SO)
-	@pth="$(SITE)/mitsuba_birefringent.pth"; \
-	if [ "$$(cat "$$pth" 2>/dev/null)" != "$(CURDIR)/plugin" ]; then \
-	  echo "$(CURDIR)/plugin" > "$$pth"; echo "installed mitsuba_birefringent into $(VENV)/ ($$pth)"; \
-	fi
 
 $(CPP_OBJ_DIR)/%.o: cpp/src/%.cpp $(CPP_HDRS) $(VENV_STAMP)
 	@mkdir -p $(@D)
@@ -144,6 +161,8 @@ gallery: setup
 ## ---- tests ------------------------------------------------------------------------------
 
 test: setup
+	$(MAKE) --no-print-directory fmt
+	$(MAKE) --no-print-directory lint
 	$(MAKE) --no-print-directory test-rust
 	$(MAKE) --no-print-directory test-python
 	$(MAKE) --no-print-directory fuzz-ci

@@ -6,7 +6,7 @@ Geometry conventions used by every scene here: the camera is orthographic, looks
 `rectangle`s parallel to the xy-plane ("layers"), whose local shading frame is (x, y, z) of the
 world (a rectangle's s axis is its dp/du, the world x axis when it is only translated and
 scaled). Hence a Mitsuba `polarizer` layer with `theta` transmits along the world direction at
-angle -theta from x (counter-clockwise seen from the camera; see the notes on Mitsuba's
+angle -theta from x (counter-clockwise seen from the camera; see docs/mitsuba.md §5 for Mitsuba's
 conventions), and a plate's `axis_angle` is counter-clockwise from x seen from the camera.
 
 A `bitmap` texture on a rectangle maps its array row 0 to the rectangle's bottom edge (y = -1

@@ -1,14 +1,13 @@
 """A thin birefringent film on glass, seen in reflection: iridescent thin-film colours.
 
-Scene 5 of the scene list (the seed's section 3, "Iridescence when reflecting off an anisotropic
-slab"): an x-cut lithium niobate film (the core's dispersive `linbo3`, n_o = 2.29, n_e = 2.20
-at 600 nm; optic axis in the film plane, along x) on fused silica (`exit_ior` 1.458), as in
-"lithium niobate on insulator" wafers. Its thickness varies over the object like a draining
-soap film, from 0.1 um at the top edge to `max_thickness_um` (0.8 um) at the bottom, with a
-slow swirl; the reflected colours run through the thin-film interference orders (Newton's
-colours), modified by the birefringence (the o and e waves have different optical
-thicknesses, so the colours depend on the azimuth of the plane of incidence relative to the
-optic axis).
+The supplemental's section 3 ("Iridescence when reflecting off an anisotropic slab"): an x-cut
+lithium niobate film (the core's dispersive `linbo3`, n_o = 2.29, n_e = 2.20 at 600 nm; optic
+axis in the film plane, along x) on fused silica (`exit_ior` 1.458), as in "lithium niobate on
+insulator" wafers. Its thickness varies over the object like a draining soap film, from 0.1 um
+at the top edge to `max_thickness_um` (0.8 um) at the bottom, with a slow swirl; the reflected
+colours run through the thin-film interference orders (Newton's colours), modified by the
+birefringence (the o and e waves have different optical thicknesses, so the colours depend on
+the azimuth of the plane of incidence relative to the optic axis).
 
 Geometry: the film is a 2 x 2 rectangle at z = 0 seen by a perspective camera 40 degrees from
 its normal; a large rectangular D65 area light sits at the camera's mirror position, so that

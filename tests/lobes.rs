@@ -145,7 +145,7 @@ fn isotropic_crystal_reflection_is_mitsubas_dielectric_and_conductor() {
 #[test]
 fn isotropic_crystal_total_internal_reflection_is_a_pure_retarder() {
     // From inside glass (1.5) at 50 deg: Mitsuba's dielectric gives cos Δ = 0.708, sin Δ = 0.706
-    // (notes, section 3.1); specular_reflection(cos, 1/1.5) reproduces it.
+    // (docs/mitsuba.md §3); specular_reflection(cos, 1/1.5) reproduces it.
     let s = Surface::new(
         C64::new(1.0, 0.0),
         Uniaxial::isotropic(C64::new(1.5, 0.0)).unwrap(),

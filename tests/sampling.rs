@@ -48,7 +48,7 @@ fn every_time_reversed_source_is_found_and_importance_conserves_energy() {
 #[test]
 fn isotropic_crystal_weights_are_mitsubas_dielectric_weights() {
     // Mitsuba 3.9.1's dielectric (int 1.5, ext 1.0) at wi = 60 deg, Radiance mode: R weight /
-    // pdf has M00 = 1 with pdf = R = 0.08919; T has M00/pdf = 1/1.5² (notes, section 3.1).
+    // pdf has M00 = 1 with pdf = R = 0.08919; T has M00/pdf = 1/1.5² (docs/mitsuba.md §3).
     let s = Surface::new(
         C64::new(1.0, 0.0),
         Uniaxial::isotropic(C64::new(1.5, 0.0)).unwrap(),

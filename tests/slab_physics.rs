@@ -64,7 +64,7 @@ fn isotropic_layer_is_the_airy_etalon() {
                         let den = re(1.0) + a[k] * b[k] * ph * ph;
                         let r_want = (a[k] + b[k] * ph * ph) / den;
                         let mut t_want = a[2 + k] * b[2 + k] * ph / den;
-                        // Flux normalisation (seed eq. S19): |t|² is the power fraction.
+                        // Flux normalisation (eq. S19): |t|² is the power fraction.
                         t_want *= flux.sqrt();
                         let e = (rk - r_want).norm().max((tk - t_want).norm());
                         if e > 1e-12 {

@@ -747,7 +747,7 @@ fn c_abi_with_f32_inputs_as_the_shim_passes_them() {
                         l.weight >= 0.0 && l.eta.is_finite() && l.eta != 0.0,
                         "lobe {l:?}"
                     );
-                    // bs.eta is a ratio of ray indices (seed eq. S14): positive for lossless media.
+                    // bs.eta is a ratio of ray indices (eq. S14): positive for lossless media.
                     // In strongly absorbing crystals the core's ray index Re(η_ef) ⟨W, ray⟩ can be
                     // negative (the Poynting vector more than 90° from Re k); counted and reported.
                     if l.eta < 0.0 {

@@ -1,16 +1,89 @@
-/* `birefringent`: the surface of a bulk uniaxial crystal (like `dielectric`); the crystal is on
- * the side opposite to the normal.
- *
- * Components: 0 specular reflection (DeltaReflection), 1 ordinary and 2 extraordinary
- * refraction (DeltaTransmission), each ray in its own (Poynting) direction. Seen from inside,
- * the core returns up to 6 lobes (reflected o and e and the transmitted ray, for each of the o
- * and e rays that can travel along wi); they are sampled in proportion to their weight like the
- * three lobes seen from outside. Which of o/e a ray inside the crystal is lives in its Stokes
- * vector, so double refraction needs a polarized variant; an isotropic material (eta_o ==
- * eta_e, kappa_o == kappa_e) works in every variant. An absorbing (isotropic) material is
- * opaque, as the core decides: the reflection alone from outside, nothing from inside. The
- * physics is the core's bfr_crystal_lobes. Parameters: see plugin/README.md.
- */
+/**!
+
+.. _bsdf-birefringent:
+
+Bulk birefringent crystal (:monosp:`birefringent`)
+--------------------------------------------------
+
+.. pluginparameters::
+
+ * - material
+   - |string|
+   - A named uniaxial crystal of the core's catalogue: calcite, crystalline quartz (quartz),
+     sapphire, rutile, magnesium fluoride (mgf2), lithium niobate, beta barium borate, potassium
+     dihydrogen phosphate (aliases accepted); dispersive. Each uses one cited dispersion fit
+     over its range; Mitsuba samples 360-830 nm, and where a fit's data stop short (rutile:
+     DeVore 1951, 430-1530 nm; lithium niobate: Zelmon et al. 1997, 400-5000 nm) the fit is
+     extrapolated down to 360 nm (finite and of normal dispersion there, but without rutile's
+     absorption below about 410 nm) and loading logs one warning saying so; the calculator
+     applies the same rule. (Default: ``calcite``)
+
+ * - eta_o, eta_e
+   - |float|
+   - Constant ordinary / extraordinary indices instead of ``material`` (give both; not together
+     with ``material``), within [1e-3, 1e3] (as is every index). Spectra are not supported
+     yet. Exposed only when given.
+   - |exposed|
+
+ * - kappa_o, kappa_e
+   - |float|
+   - Extinction coefficients added to the indices (``n + i kappa``, ``0 <= kappa <= 1e3``),
+     accepted only for an isotropic material (a metal-like surface): in an absorbing
+     birefringent crystal the o and e waves are not power-orthogonal, so the power of each
+     refracted ray is undefined (refused at load with that reason; use
+     :monosp:`thinbirefringent` for a dichroic plate). An absorbing bulk is opaque, like
+     :monosp:`conductor`: what refracts into it is absorbed at the surface, so there is the
+     reflection alone from outside and nothing from inside. (Default: 0)
+   - |exposed|
+
+ * - optic_axis
+   - |vector|
+   - The optic axis, any non-zero length, in the frame that ``optic_axis_space`` names.
+     (Default: ``[1, 0, 0]``)
+   - |exposed|
+
+ * - optic_axis_space
+   - |string|
+   - ``"local"``: ``optic_axis`` is in the shading frame (x = dp/du, z = normal; fine for a flat
+     face, e.g. a ``rectangle``); ``"world"``: in world space, converted to each hit's shading
+     frame, so that every face of a crystal object (a ``cube``, a mesh) sees the same crystal.
+     (Default: ``"local"``)
+
+ * - ext_ior
+   - |float| or |string|
+   - Real index of the medium on the side the normal points to, a number or a Mitsuba IOR name.
+     (Default: ``"air"``, 1.000277)
+   - |exposed|
+
+The surface of a bulk uniaxial crystal, like :monosp:`dielectric`: the crystal is on the side
+opposite to the normal. Components: 0 the specular reflection (``DeltaReflection``), 1 the
+ordinary and 2 the extraordinary refraction (``DeltaTransmission``), each ray in its own
+(Poynting) direction; the extraordinary ray leaves the plane of incidence. Seen from inside, the
+core returns up to 6 lobes (the reflected o and e rays and the transmitted ray, for each of the
+o and e rays that can travel along ``wi``): the reflected rays are component 0 and the ray
+refracted out is component 1 or 2 by its mode inside. Lobes are sampled in proportion to their
+unpolarised weight. Which of o and e a ray inside the crystal is lives in its Stokes vector, so
+double refraction needs a polarized variant; an isotropic material (``eta_o == eta_e``,
+``kappa_o == kappa_e``) works in every variant. The physics is the core's
+``bfr_crystal_lobes`` (docs/physics.md, sections 2 and 5).
+
+.. tabs::
+    .. code-tab:: xml
+        :name: birefringent-calcite
+
+        <bsdf type="birefringent">
+            <string name="material" value="calcite"/>
+            <vector name="optic_axis" x="0.577" y="0.577" z="0.577"/>
+            <string name="optic_axis_space" value="world"/>
+        </bsdf>
+
+    .. code-tab:: python
+
+        'type': 'birefringent',
+        'material': 'calcite',
+        'optic_axis': [0.577, 0.577, 0.577],
+        'optic_axis_space': 'world'
+*/
 #include "common.h"
 
 NAMESPACE_BEGIN(mitsuba)

@@ -1,12 +1,132 @@
-/* `thinbirefringent`: a plane-parallel uniaxial plate on a surface (like `thindielectric`).
- *
- * Components: 0 specular reflection (DeltaReflection), 1 straight-through transmission (Null when
- * exit_ior == ext_ior, else DeltaTransmission in the direction the core returns). Both carry the
- * plate's full Mueller matrix, multiple internal reflections included. With absorbing_exit the
- * medium below absorbs whatever enters it (a film on a black substrate): only component 0 on the
- * front side remains. Parameters: see plugin/README.md. The physics is the core's
- * bfr_plate_lobes / bfr_plate_lobes_rgb.
- */
+/**!
+
+.. _bsdf-thinbirefringent:
+
+Birefringent plate (:monosp:`thinbirefringent`)
+-----------------------------------------------
+
+.. pluginparameters::
+
+ * - material
+   - |string|
+   - A named uniaxial crystal of the core's catalogue: calcite, crystalline quartz (quartz),
+     sapphire, rutile, magnesium fluoride (mgf2), lithium niobate, beta barium borate, potassium
+     dihydrogen phosphate (aliases accepted); dispersive. Each uses one cited dispersion fit
+     over its range; Mitsuba samples 360-830 nm, and where a fit's data stop short (rutile:
+     DeVore 1951, 430-1530 nm; lithium niobate: Zelmon et al. 1997, 400-5000 nm) the fit is
+     extrapolated down to 360 nm (finite and of normal dispersion there, but without rutile's
+     absorption below about 410 nm) and loading logs one warning saying so; the calculator
+     applies the same rule. (Default: ``calcite``)
+
+ * - eta_o, eta_e
+   - |float|
+   - Constant ordinary / extraordinary indices instead of ``material`` (give both; not together
+     with ``material``), within [1e-3, 1e3] (as is every index). Spectra are not supported
+     yet. Exposed only when given.
+   - |exposed|
+
+ * - kappa_o, kappa_e
+   - |float|
+   - Extinction coefficients added to the indices (``n + i kappa``, ``0 <= kappa <= 1e3``;
+     dichroism when they differ). (Default: 0)
+   - |exposed|
+
+ * - optic_axis
+   - |vector|
+   - The optic axis in the local shading frame (x = dp/du, z = normal), any non-zero length; at
+     each point rotated about the normal by ``axis_angle``. (Default: ``[1, 0, 0]``)
+   - |exposed|
+
+ * - ext_ior
+   - |float| or |string|
+   - Real index of the medium on the side the normal points to, a number or a Mitsuba IOR name.
+     (Default: ``"air"``, 1.000277)
+   - |exposed|
+
+ * - exit_ior
+   - |float| or |string|
+   - Real index of the medium below the plate. (Default: ``ext_ior``)
+   - |exposed|
+
+ * - thickness
+   - |float| or |texture|
+   - Thickness in micrometres (times ``thickness_scale``), within [0, 1e6] (1 m); where a texture
+     gives a value outside, that point returns no light (one warning). (Default: 1)
+   - |exposed|
+
+ * - thickness_scale
+   - |float|
+   - Multiplies ``thickness`` (e.g. a bitmap in [0, 1] times a maximum thickness). (Default: 1)
+   - |exposed|
+
+ * - birefringence
+   - |float| or |texture|
+   - Added to Re ``eta_e`` (times ``birefringence_scale``): the stress-induced birefringence
+     ``C (sigma_1 - sigma_2)`` of a photoelastic plate. Exposed only when given. (Default: none)
+   - |exposed|
+
+ * - birefringence_scale
+   - |float|
+   - Multiplies ``birefringence``. (Default: 1)
+   - |exposed|
+
+ * - axis_angle
+   - |float| or |texture|
+   - Degrees; rotates ``optic_axis`` about the normal, counter-clockwise seen from the exterior
+     (from x towards y): the principal stress direction of a photoelastic plate. Exposed only
+     when given. (Default: 0)
+   - |exposed|
+
+ * - filter_bandwidth
+   - |float|
+   - Spectral variants: full width at half maximum (nm) of the Gaussian band around each sampled
+     wavelength over which the plate is integrated in closed form; 0 (or below 1e-12 of the
+     wavelength) is the exact plate at the wavelength; at most a quarter of the wavelength.
+     (Default: 4)
+   - |exposed|
+
+ * - absorbing_exit
+   - |bool|
+   - The medium below the plate absorbs all light that enters it (a film on a black substrate;
+     ``exit_ior`` still sets the bottom interface): only the reflection lobe, on the front side,
+     remains; light arriving from below is not reflected (it cannot reach the plate). Removes the
+     noise of choosing between reflection and transmission when only the reflection is seen.
+     (Default: |false|)
+
+A plane-parallel uniaxial plate on a surface, like :monosp:`thindielectric`: the plate has no
+geometric thickness in the scene. Component 0 is the specular reflection (``DeltaReflection``),
+component 1 the transmission, which leaves in the direction Snell's law gives between
+``ext_ior`` and ``exit_ior``: straight through, with the flag ``Null`` and
+``eval_null_transmission`` (so that volpath reaches lights behind it), when
+``exit_ior == ext_ior``; ``DeltaTransmission`` otherwise. Both carry the plate's full Mueller
+matrix with every internal reflection, from either side and in both transport modes (the
+physics is the core's ``bfr_plate_lobes``, ``bfr_plate_lobes_n`` and ``bfr_plate_lobes_rgb``;
+see docs/physics.md, sections 3 and 4). Lobes are sampled in proportion to their unpolarised
+weight. With ``absorbing_exit`` only component 0 remains, on the front side. Textures are
+evaluated with ``eval_1`` at the hit point (use ``raw="true"`` for data bitmaps).
+
+.. tabs::
+    .. code-tab:: xml
+        :name: thinbirefringent-photoelastic
+
+        <bsdf type="thinbirefringent">
+            <float name="eta_o" value="1.5"/>
+            <float name="eta_e" value="1.5"/>
+            <float name="thickness" value="3000"/>
+            <texture type="bitmap" name="birefringence">
+                <string name="filename" value="dsigma.exr"/>
+                <boolean name="raw" value="true"/>
+            </texture>
+            <float name="birefringence_scale" value="1e-4"/>
+        </bsdf>
+
+    .. code-tab:: python
+
+        'type': 'thinbirefringent',
+        'material': 'quartz',
+        'optic_axis': [1, 1, 0],
+        'thickness': 30.0
+*/
 #include "common.h"
 
 NAMESPACE_BEGIN(mitsuba)

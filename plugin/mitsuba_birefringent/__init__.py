@@ -10,21 +10,32 @@ Importing the package registers both plugins with Mitsuba's plugin manager::
 
 They work in the variants listed in :data:`VARIANTS` (the llvm/cuda variants raise a clear error
 at scene load). The optics is computed by the Rust core linked into the plugin library; see
-``plugin/README.md`` for the parameters.
+``plugin/README.md`` for the parameters. XML scenes render with the command
+``mitsuba-birefringent`` (:mod:`mitsuba_birefringent.cli`); Mitsuba's own ``mitsuba`` command
+cannot load these plugins.
 
-The plugin library is ``libmitsuba_birefringent.so`` next to this file (``make setup`` builds
-it); the environment variable ``MITSUBA_BIREFRINGENT_LIBRARY`` overrides its path.
+The plugin library is ``libmitsuba_birefringent.so`` next to this file (``pip install .`` at the
+repository root builds it, and so does ``make setup``); the environment variable
+``MITSUBA_BIREFRINGENT_LIBRARY`` overrides its path.
 """
 
 from __future__ import annotations
 
 import ctypes
+import importlib.metadata
 import os
 from pathlib import Path
 
 import mitsuba  # loads libmitsuba (and its PluginManager) before the plugin library
 
-__all__ = ["PLUGINS", "VARIANTS", "library_path", "core_version", "register"]
+__all__ = ["PLUGINS", "VARIANTS", "__version__", "library_path", "core_version", "register"]
+
+try:
+    #: The installed distribution's version (Cargo.toml's, written by the build backend).
+    __version__ = importlib.metadata.version("mitsuba-birefringent")
+except importlib.metadata.PackageNotFoundError:
+    raise ImportError("mitsuba_birefringent is not installed (no distribution metadata): run "
+                      "`pip install .` (or `make setup`) at the repository root") from None
 
 #: The BSDF plugin names this package registers.
 PLUGINS = ("thinbirefringent", "birefringent")
@@ -49,7 +60,7 @@ def _load() -> ctypes.CDLL:
         if not path.is_file():
             raise ImportError(
                 f"mitsuba_birefringent: the plugin library {path} does not exist; "
-                "build it with `make setup` at the repository root"
+                "install the package with `pip install .` (or `make setup`) at the repository root"
             )
         # Make sure this process's libmitsuba is the wheel's (the plugin library needs it loaded).
         ctypes.CDLL(str(Path(mitsuba.__file__).resolve().parent / "libmitsuba.so"),

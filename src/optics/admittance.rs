@@ -1,8 +1,8 @@
-//! Admittance reduction of the boundary system (seed eqs. S17-S18) when one of the two media is
+//! Admittance reduction of the boundary system (eqs. S17-S18) when one of the two media is
 //! isotropic: the 4x4 solve of [`crate::optics::interface`] becomes one 2x2 solve plus
 //! back-substitution, with the same scattering matrix.
 //!
-//! Write the continuity of tangential `ψ = (E_x, E_y, H_x, H_y)` (seed eq. S18) as
+//! Write the continuity of tangential `ψ = (E_x, E_y, H_x, H_y)` (eq. S18) as
 //! `I x_in + O x_out = A_out y_out + A_in y_in`: `I`, `O` are the incoming and outgoing s/p
 //! modes of the isotropic medium (amplitudes `x`), `A_in`, `A_out` those of the other medium
 //! (amplitudes `y`), incoming amplitudes known. An isotropic s mode has only `(E_y, H_x)`, a

@@ -1,11 +1,11 @@
-//! Closed-form o and e fields of a uniaxial medium for known normal components (seed eqs.
+//! Closed-form o and e fields of a uniaxial medium for known normal components (supplemental eqs.
 //! S9-S10), in real or complex arithmetic ([`Scalar`]): lossless media with propagating waves
 //! have real fields, and the same steps in `f64` give what the complex ones reduce to.
 //!
 //! Working frame of [`crate::optics::modes`]: `k = (β, 0, q)` in units of `k0`. The displacement of the
 //! o-wave is `D_o ∝ k × A`, that of the e-wave `D_e ∝ k × (k × A)` (both ⟂ k), and
-//! `E = ε⁻¹ D` with `ε⁻¹ = I/ε_o + Δ(1/ε) A Aᵀ` (seed eq. S6); `E` has unit Hermitian norm,
-//! `H = k × E` (seed eq. S2). If `k` is (numerically) along the axis, `k × A` vanishes, o and e
+//! `E = ε⁻¹ D` with `ε⁻¹ = I/ε_o + Δ(1/ε) A Aᵀ` (eq. S6); `E` has unit Hermitian norm,
+//! `H = k × E` (eq. S2). If `k` is (numerically) along the axis, `k × A` vanishes, o and e
 //! are degenerate and `ŷ` stands in for `k × A`; the two fields still span the transverse plane.
 
 use crate::cmath::Scalar;
@@ -59,7 +59,7 @@ impl<T: Scalar> Fields<T> {
 
     /// The e-wave of normal component `q`. `ek_z = Some((εk)_z)` for a lossless propagating
     /// wave (real `T`): its flux is then evaluated without cancellation. Its ray is `∝ ε k`
-    /// (seed eq. S12), so `S_z = (S·k) (εk)_z / (kᵀεk)` with `(εk)_z = a q + b = ±w` known
+    /// (eq. S12), so `S_z = (S·k) (εk)_z / (kᵀεk)` with `(εk)_z = a q + b = ±w` known
     /// exactly from the root (near `K_max` the direct `½(E×H*)_z` loses digits).
     #[inline(always)]
     pub fn extraordinary(&self, q: T, ek_z: Option<f64>) -> Wave<T> {
@@ -123,7 +123,7 @@ impl<T: Scalar> Fields<T> {
     }
 }
 
-/// `k × v` for `k = (β, 0, q)` (seed eq. S2 for `v = E`), written out for the zero `k_y`.
+/// `k × v` for `k = (β, 0, q)` (eq. S2 for `v = E`), written out for the zero `k_y`.
 #[inline(always)]
 pub fn k_cross<T: Scalar>(beta: T, q: T, v: &V3<T>) -> V3<T> {
     [-(q * v[1]), q * v[0] - beta * v[2], beta * v[1]]

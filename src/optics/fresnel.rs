@@ -5,7 +5,7 @@
 //! Conventions of [`crate::optics::modes::isotropic_modes`]: `E_s = ŷ`, `E_p = k̂ × ŷ`, normal
 //! components `q = ±w` with `w = sqrt(η² − β²)` the principal root (`Re w ≥ 0`, `Im w ≥ 0`
 //! for the wave that travels or decays upwards). Matching tangential `E` and `H = k × E`
-//! (seed eq. S18 for two isotropic media) gives the textbook amplitudes
+//! (eq. S18 for two isotropic media) gives the textbook amplitudes
 //!
 //! ```text
 //! r_s = (w₁ − w₂)/(w₁ + w₂)               t_s = 2 w₁/(w₁ + w₂)

@@ -1,6 +1,6 @@
 //! One planar interface between two homogeneous (isotropic or uniaxial) media: the 4x4
-//! boundary system (seed eqs. S17-S18) solved once for waves arriving from either side, and the
-//! power ratios (seed eq. S19).
+//! boundary system (eqs. S17-S18) solved once for waves arriving from either side, and the
+//! power ratios (eq. S19).
 //!
 //! The upper medium fills `z > 0`, the lower one `z < 0` (working frame of [`crate::optics::modes`]).
 //! Tangential `E` and `H` are continuous across `z = 0`; writing every field as a sum of modes,
@@ -113,7 +113,7 @@ impl Interface {
         Interface { upper, lower, s }
     }
 
-    /// Solves the boundary system for given mode sets (seed eq. S18).
+    /// Solves the boundary system for given mode sets (eq. S18).
     pub fn from_modes(upper: ModeSet, lower: ModeSet) -> Result<Self> {
         let s = from_modes_s(&upper, &lower)?;
         Ok(Interface { upper, lower, s })
@@ -139,7 +139,7 @@ impl Interface {
         self.s.fixed_view::<2, 2>(2, 2).into_owned()
     }
 
-    /// Power ratios (seed eq. S19) of the whole scattering matrix: entry `(i, j)` is the flux
+    /// Power ratios (eq. S19) of the whole scattering matrix: entry `(i, j)` is the flux
     /// carried by outgoing wave `i` per unit flux of incoming wave `j`, each wave's own normal
     /// Poynting flux (`|S_ij|² |P_i| / |P_j|`). Evanescent waves in lossless media carry none.
     /// Columns of incoming waves that carry no flux are zero.

@@ -9,7 +9,7 @@
 //! arriving from inside couples only the `x` component of its Stokes frame.
 //!
 //! Jones matrices are flux-normalised: `|J e|²` is the power fraction carried by the outgoing
-//! wave (seed eq. S19), so the Mueller matrix's `M00` is the power ratio for unpolarised light.
+//! wave (eq. S19), so the Mueller matrix's `M00` is the power ratio for unpolarised light.
 
 use crate::error::{Error, Result};
 use crate::optics::frame::PlaneFrame;
@@ -34,7 +34,7 @@ pub struct Lobe {
     pub jones: Matrix2<C64>,
     /// Its Mueller matrix in Mitsuba's convention.
     pub mueller: Matrix4<f64>,
-    /// Ray index of the outgoing wave (seed eq. S14).
+    /// Ray index of the outgoing wave (eq. S14).
     pub ray_index: f64,
 }
 
@@ -45,7 +45,7 @@ pub struct Event {
     pub incident_direction: Vector3<f64>,
     /// `x` axis of the incident wave's Stokes frame.
     pub incident_stokes_x: Vector3<f64>,
-    /// Ray index of the incident wave (seed eq. S14).
+    /// Ray index of the incident wave (eq. S14).
     pub incident_ray_index: f64,
     /// Outside incidence: `[exterior wave, —]`; inside: `[o, e]` (waves into the crystal).
     pub reflected: [Option<Lobe>; 2],

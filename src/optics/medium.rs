@@ -1,6 +1,6 @@
 //! Uniaxial media at one wavelength: complex ordinary and extraordinary indices and an optic axis.
 //!
-//! Time convention of the whole core: fields vary as `exp(i (k·r − ω t))` (the seed's
+//! Time convention of the whole core: fields vary as `exp(i (k·r − ω t))` (the supplemental's
 //! convention), so an absorbing index is `n + iκ` with `κ ≥ 0` and a wave decays along the
 //! imaginary part of its wave vector. The Mitsuba boundary converts once (see `mueller`).
 
@@ -10,9 +10,9 @@ use nalgebra::{Matrix3, Vector3};
 use num_complex::Complex64 as C64;
 
 /// A homogeneous, non-magnetic uniaxial medium: permittivity
-/// `ε = ε_o I + (ε_e − ε_o) A Aᵀ` (seed eq. S6) with `ε_o = η_o²`, `ε_e = η_e²`.
+/// `ε = ε_o I + (ε_e − ε_o) A Aᵀ` (eq. S6) with `ε_o = η_o²`, `ε_e = η_e²`.
 ///
-/// Dichroism (seed eq. S16) is carried by separate extinction coefficients in `η_o` and `η_e`:
+/// Dichroism (eq. S16) is carried by separate extinction coefficients in `η_o` and `η_e`:
 /// light polarised perpendicular to `A` sees `κ_o`, light polarised along `A` sees `κ_e`.
 /// `η_o == η_e` (bit for bit) makes the medium isotropic, and the core then uses s/p modes.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -82,7 +82,7 @@ impl Uniaxial {
         Uniaxial { axis, ..*self }
     }
 
-    /// The permittivity tensor `ε_o I + Δε A Aᵀ` (seed eq. S6).
+    /// The permittivity tensor `ε_o I + Δε A Aᵀ` (eq. S6).
     pub fn permittivity(&self) -> Matrix3<C64> {
         let a = self.axis.map(|x| C64::new(x, 0.0));
         Matrix3::identity() * self.eps_o() + a * a.transpose() * (self.eps_e() - self.eps_o())

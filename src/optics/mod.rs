@@ -1,6 +1,6 @@
 //! The optics of one interface between isotropic and uniaxial media at one wavelength: the
 //! media, their normal modes and fields, the interface's scattering matrix, and the Stokes and
-//! Mueller algebra of the light it scatters (seed eqs. S1-S19).
+//! Mueller algebra of the light it scatters (eqs. S1-S19).
 
 pub mod admittance;
 pub mod fields;

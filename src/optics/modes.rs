@@ -3,9 +3,9 @@
 //! Working frame of this module (the "plane-of-incidence frame"): `z` is the surface normal
 //! pointing into the upper (exterior) medium, `x` is the direction of the tangential wave
 //! vector shared by every wave at the interface, `y = z × x` is the s direction. Every wave has
-//! the wave vector `k = k0 (β, 0, q)`: `β = K/k0` is the incidence parameter (seed eq. S1) and
-//! `q` the normal component (seed eq. S9). Lengths of wave vectors are in units of `k0`, so
-//! nothing here depends on the wavelength (the seed's "note regarding k").
+//! the wave vector `k = k0 (β, 0, q)`: `β = K/k0` is the incidence parameter (eq. S1) and
+//! `q` the normal component (eq. S9). Lengths of wave vectors are in units of `k0`, so
+//! nothing here depends on the wavelength (the supplemental's "note regarding k").
 
 use crate::cmath::{self, Scalar};
 use crate::optics::fields::{Fields, Wave};
@@ -40,13 +40,13 @@ pub enum ModeKind {
 pub struct Mode {
     /// Polarisation family.
     pub kind: ModeKind,
-    /// Tangential wave-vector component `β = K/k0` (seed eq. S1).
+    /// Tangential wave-vector component `β = K/k0` (eq. S1).
     pub beta: C64,
-    /// Normal wave-vector component `q/k0` (seed eq. S9).
+    /// Normal wave-vector component `q/k0` (eq. S9).
     pub q: C64,
-    /// Electric field (seed eq. S10).
+    /// Electric field (eq. S10).
     pub e: C3,
-    /// Magnetic field `k × E` (seed eq. S2).
+    /// Magnetic field `k × E` (eq. S2).
     pub h: C3,
     /// Normal Poynting flux `½ Re(E × H*)_z` of the unit-amplitude mode (positive upwards).
     pub flux: f64,
@@ -58,7 +58,7 @@ impl Mode {
         wave_vector(self.beta, self.q)
     }
 
-    /// The tangential field components `(E_x, E_y, H_x, H_y)` matched at a boundary (seed eq. S18).
+    /// The tangential field components `(E_x, E_y, H_x, H_y)` matched at a boundary (eq. S18).
     pub fn tangential(&self) -> [C64; 4] {
         [self.e.x, self.e.y, self.h.x, self.h.y]
     }
@@ -75,14 +75,14 @@ impl Mode {
         self.flux
     }
 
-    /// Unit ray (Poynting) direction (seed eq. S12); `None` if the mode carries no power.
+    /// Unit ray (Poynting) direction (eq. S12); `None` if the mode carries no power.
     pub fn ray_direction(&self) -> Option<Vector3<f64>> {
         let s = self.poynting();
         let n = s.norm();
         (n > 0.0 && n.is_finite()).then(|| s / n)
     }
 
-    /// Unit wave-normal direction `Re(k)/|Re(k)|` (seed eq. S11).
+    /// Unit wave-normal direction `Re(k)/|Re(k)|` (eq. S11).
     pub fn wave_direction(&self) -> Vector3<f64> {
         let k = Vector3::new(self.beta.re, 0.0, self.q.re);
         let n = k.norm();
@@ -93,12 +93,12 @@ impl Mode {
         }
     }
 
-    /// Effective index `sqrt(q² + β²)` seen by the wave (seed eq. S13); complex with absorption.
+    /// Effective index `sqrt(q² + β²)` seen by the wave (eq. S13); complex with absorption.
     pub fn effective_index(&self) -> C64 {
         cmath::sqrt(self.q * self.q + self.beta * self.beta)
     }
 
-    /// Ray (phase) index along the Poynting direction, `Re(η_ef) ⟨W, I⟩` (seed eq. S14);
+    /// Ray (phase) index along the Poynting direction, `Re(η_ef) ⟨W, I⟩` (eq. S14);
     /// `None` for a mode that carries no power.
     pub fn ray_index(&self) -> Option<f64> {
         let ray = self.ray_direction()?;
@@ -106,7 +106,7 @@ impl Mode {
     }
 
     /// True for a wave that carries (numerically) no power through the surface although its
-    /// field does not vanish: an evanescent wave past `K_max` (seed eq. S15) in a lossless medium.
+    /// field does not vanish: an evanescent wave past `K_max` (eq. S15) in a lossless medium.
     /// (An e-wave past `K_max` keeps a real part of `q`; only its flux tells.)
     pub fn is_evanescent(&self) -> bool {
         let scale = self.e.norm() * self.h.norm();
@@ -130,7 +130,7 @@ pub fn wave_vector(beta: C64, q: C64) -> C3 {
 }
 
 /// The normal modes of `medium` (its axis given in the working frame) for incidence parameter
-/// `beta` (seed eqs. S9-S10). Isotropic media get s/p modes.
+/// `beta` (eqs. S9-S10). Isotropic media get s/p modes.
 #[inline(always)]
 pub fn modes(medium: &Uniaxial, beta: C64) -> ModeSet {
     if medium.is_isotropic() {
@@ -224,7 +224,7 @@ pub fn isotropic_modes(eta: C64, beta: C64) -> ModeSet {
     }
 }
 
-/// Normal components of the extraordinary wave, `(q_e⁺, q_e⁻)` (seed eq. S9).
+/// Normal components of the extraordinary wave, `(q_e⁺, q_e⁻)` (eq. S9).
 ///
 /// From `kᵀ ε k = ε_o ε_e` with `k = (β, 0, q)`: `a q² + 2 b q + c = 0`, `a = ε_o + Δε A_z²`,
 /// `b = Δε β A_x A_z`, discriminant `ε_o [ε_e a − β² (ε_e − Δε A_y²)]`.
@@ -272,9 +272,9 @@ fn extraordinary_coefficients<T: Scalar>(
 }
 
 /// Maximal incidence parameters `(K_o^max, K_e^max)/k0` beyond which the o and e waves are
-/// evanescent (seed eq. S15). For the e-wave: `K² = ε_e (ε_o + Δε A_z²) / (ε_e − Δε A_y²)`, with
-/// `A_z` the normal and `A_y` the s (out-of-plane) component of the axis. (The seed prints the
-/// in-plane tangential component in the denominator; the discriminant of its eq. S9 gives the
+/// evanescent (eq. S15). For the e-wave: `K² = ε_e (ε_o + Δε A_z²) / (ε_e − Δε A_y²)`, with
+/// `A_z` the normal and `A_y` the s (out-of-plane) component of the axis. (S15 as printed has the
+/// in-plane tangential component in the denominator; the discriminant of eq. S9 gives the
 /// out-of-plane one, which is what is implemented and tested.)
 pub fn k_max(medium: &Uniaxial) -> (C64, C64) {
     let (eo, ee) = (medium.eps_o(), medium.eps_e());
@@ -284,7 +284,7 @@ pub fn k_max(medium: &Uniaxial) -> (C64, C64) {
     (medium.eta_o, ke)
 }
 
-/// o and e modes of a (non-isotropic) uniaxial medium (seed eqs. S9-S10), fields from
+/// o and e modes of a (non-isotropic) uniaxial medium (eqs. S9-S10), fields from
 /// [`crate::optics::fields`]: in real arithmetic when every wave vector and field is real (lossless
 /// medium, real `β`, both waves propagating), else in complex arithmetic.
 #[inline(always)]
@@ -344,7 +344,7 @@ fn uniaxial_pairs<T: Scalar>(
 }
 
 /// Wave vector (units of `k0`) of the e-wave whose ray (Poynting) direction is `ray` (unit,
-/// same frame as the axis): the inverse of seed eq. S12 for a lossless uniaxial medium.
+/// same frame as the axis): the inverse of eq. S12 for a lossless uniaxial medium.
 ///
 /// The e-wave's ray is the normal of its index surface `kᵀ ε k = ε_o ε_e`, i.e. `∝ ε k`, hence
 /// `k = ε⁻¹ ŝ · sqrt(ε_o ε_e / ŝᵀ ε⁻¹ ŝ)`. Absorption is ignored (real parts of ε are used).
@@ -357,7 +357,7 @@ pub fn extraordinary_wave_vector_from_ray(medium: &Uniaxial, ray: Vector3<f64>) 
 }
 
 /// Effective index of a wave travelling along the unit wave normal `dir`: `η_o` for the o-wave,
-/// `η(θ) = sqrt(ε_o ε_e / (d̂ᵀ ε d̂))` for the e-wave (seed eq. S13 evaluated from the direction).
+/// `η(θ) = sqrt(ε_o ε_e / (d̂ᵀ ε d̂))` for the e-wave (eq. S13 evaluated from the direction).
 pub fn index_along(medium: &Uniaxial, kind: ModeKind, dir: Vector3<f64>) -> C64 {
     match kind {
         ModeKind::E if !medium.is_isotropic() => {

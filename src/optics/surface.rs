@@ -53,7 +53,7 @@ impl Surface {
         self.crystal.with_axis(frame.to_working(self.crystal.axis))
     }
 
-    /// Incidence parameter `β = η sin θ` (seed eq. S1) of a wave whose wave normal makes the
+    /// Incidence parameter `β = η sin θ` (eq. S1) of a wave whose wave normal makes the
     /// angle `theta` with the normal, in the plane of `frame`. For an e-wave inside, `η` is the
     /// direction-dependent extraordinary index.
     pub fn beta(&self, incident: Incident, frame: &PlaneFrame, theta: f64) -> C64 {
@@ -76,19 +76,19 @@ impl Surface {
         Ok(Solved { frame, interface })
     }
 
-    /// `(K_o^max, K_e^max)/k0` of the crystal in the plane of `frame` (seed eq. S15).
+    /// `(K_o^max, K_e^max)/k0` of the crystal in the plane of `frame` (eq. S15).
     pub fn k_max(&self, frame: &PlaneFrame) -> (C64, C64) {
         k_max(&self.crystal_in(frame))
     }
 }
 
 impl Solved {
-    /// Ray (Poynting) direction of a mode in the local frame (seed eq. S12).
+    /// Ray (Poynting) direction of a mode in the local frame (eq. S12).
     pub fn ray_local(&self, mode: &Mode) -> Option<Vector3<f64>> {
         mode.ray_direction().map(|d| self.frame.to_local(d))
     }
 
-    /// Wave-normal direction of a mode in the local frame (seed eq. S11).
+    /// Wave-normal direction of a mode in the local frame (eq. S11).
     pub fn wave_local(&self, mode: &Mode) -> Vector3<f64> {
         self.frame.to_local(mode.wave_direction())
     }

@@ -13,7 +13,7 @@
 //! ```
 //! (the slab of [`crate::plate::slab`] with diagonal blocks, up to the common single-pass phase of
 //! `T`, which cancels in every power term). The Jones matrices are diagonal, so the Mueller
-//! matrix needs only the coherencies `C_xy = ⟨conj(A_x) A_y⟩` (physics notes §4). Over the
+//! matrix needs only the coherencies `C_xy = ⟨conj(A_x) A_y⟩` (docs/physics.md §4). Over the
 //! band `G(k; μ, σ)`, a pair of paths whose round-trip counts differ by `Δ` keeps
 //! `⟨h^Δ⟩ = h(μ)^Δ g(Δ)` with `g(Δ) = exp(−2 σ² d² w² Δ²)`, so the double sums over paths
 //! collapse to single sums over `Δ` (geometric sums over the common count):

@@ -1,10 +1,10 @@
-//! The path-class expansion of the slab (seed eqs. S20-S26, physics notes §4).
+//! The path-class expansion of the slab (eqs. S20-S26, docs/physics.md §4).
 //!
 //! Expanding `(I − D)⁻¹ = Σₙ Dⁿ` writes each Jones matrix as a sum over path classes
 //! `J(k) = Σ_c A_c exp(i k d Q_c)`: a class collects every internal path with the same number of
 //! o and e traversals in each direction (`counts = [o↓, e↓, o↑, e↑]`), which share the phase
-//! `k d Q_c`, `Q_c = −n_o↓ q_o↓ − n_e↓ q_e↓ + n_o↑ q_o↑ + n_e↑ q_e↑` (`k d ΔP_c` of the seed for a
-//! plane-parallel plate). Amplitudes `A_c` are products of interface coefficients and do not
+//! `k d Q_c`, `Q_c = −n_o↓ q_o↓ − n_e↓ q_e↓ + n_o↑ q_o↑ + n_e↑ q_e↑` (the supplemental's `k d ΔP_c`
+//! for a plane-parallel plate). Amplitudes `A_c` are products of interface coefficients and do not
 //! depend on `k` at fixed indices. Orders beyond the chosen `N` are summed incoherently in
 //! closed form ([`IncoherentTail`]).
 
@@ -30,7 +30,7 @@ pub struct PathClass {
     pub amplitude: Matrix2<C64>,
 }
 
-/// The closed-form incoherent sum of all orders `> N` (physics notes §4): coherence between
+/// The closed-form incoherent sum of all orders `> N` (docs/physics.md §4): coherence between
 /// o and e, and between different paths, is dropped; mode populations propagate with
 /// `|P|²` and reflect with `|r|²`. Stored as Mueller matrices (Mitsuba's convention).
 #[derive(Clone, Copy, Debug, PartialEq)]

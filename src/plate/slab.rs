@@ -1,6 +1,6 @@
 //! The plane-parallel uniaxial plate (slab) of thickness `d` between two isotropic media, exact at
-//! one wavelength: every internal path summed in closed form (physics notes §3; the plane-wave
-//! form of seed eqs. S20-S26).
+//! one wavelength: every internal path summed in closed form (docs/physics.md §3; the plane-wave
+//! form of eqs. S20-S26).
 //!
 //! With the interface blocks of [`crate::optics::interface`] (top interface: exterior above, crystal
 //! below; bottom interface: crystal above, exit medium below) and the propagation matrices
@@ -181,7 +181,7 @@ impl SlabOptics {
         }
     }
 
-    /// Flux ratio per unit amplitude `P_bottom / P_top` (transmission power factor, seed S19).
+    /// Flux ratio per unit amplitude `P_bottom / P_top` (transmission power factor, eq. S19).
     pub fn transmission_flux_ratio(&self) -> f64 {
         let p_in = self.top.upper.down[0].flux.abs();
         let p_out = self.bottom.lower.down[0].flux.abs();

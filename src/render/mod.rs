@@ -36,7 +36,7 @@ pub struct PathLobe {
     /// `x` axis of the Stokes frame of the light leaving along `wi_hat`.
     pub out_stokes_x: Vector3<f64>,
     /// Physical Mueller matrix (Mitsuba's convention); in Radiance mode scaled by
-    /// `(n_wi / n_wo)²` (radiance across an index step, ray indices of seed eq. S14).
+    /// `(n_wi / n_wo)²` (radiance across an index step, ray indices of eq. S14).
     pub mueller: Matrix4<f64>,
     /// `mueller[(0,0)]`, the unpolarised throughput used to pick a lobe.
     pub weight: f64,

@@ -1,4 +1,4 @@
-//! Closed-form spectral integration of the plate's Mueller matrices (physics notes §4).
+//! Closed-form spectral integration of the plate's Mueller matrices (docs/physics.md §4).
 //!
 //! A spectral weight `w(k)` (camera channel × illuminant, or a narrow band around one sampled
 //! wavelength) is a sum of Gaussians in wavenumber `k = 2π/λ`. Each Mueller matrix is a double
@@ -11,9 +11,9 @@
 //! Φ₁ = d Δ(Q + μ Q')   (group path difference),   Φ₂ = d Δ(2 Q' + μ Q'')   (its dispersion)
 //! ```
 //! which is exact for a phase quadratic in `k` (`Φ₂ = 0` without dispersion gives the plain
-//! Gaussian decay of the notes). Absorption enters `Φ₁` as its imaginary part (exact for an
-//! attenuation `exp(−k d Im ΔQ)` linear in `k`); Fresnel amplitudes are evaluated at `μ` (they
-//! vary slowly). Orders beyond `N` are the
+//! Gaussian decay of docs/physics.md §4). Absorption enters `Φ₁` as its imaginary part (exact
+//! for an attenuation `exp(−k d Im ΔQ)` linear in `k`); Fresnel amplitudes are evaluated at `μ`
+//! (they vary slowly). Orders beyond `N` are the
 //! incoherent closed-form tail of [`crate::plate::paths`]. Pairs whose group path difference is far
 //! beyond the coherence length `1/σ` are skipped (their factor is below `e^{-18}`).
 //!

@@ -1,0 +1,139 @@
+"""The documentation stays true to the code: docs/architecture.md maps every module, the code
+cites only documents (and sections) that exist, and the plugins' parameter docs (the leading
+/**! block of each cpp/src/<plugin>.cpp) name exactly the properties each plugin reads and the
+parameters it exposes, with plugin/README.md's tables generated from them.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import pathlib
+import re
+import subprocess
+import sys
+
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+DOCS = ROOT / "docs"
+
+#: The modules docs/architecture.md must map: the core, the ABI header, the shim, the package
+#: and its build backend.
+MODULE_GLOBS = ("src/**/*.rs", "cpp/include/*.h", "cpp/src/*", "plugin/mitsuba_birefringent/*.py",
+                "build_backend/*.py")
+#: Where citations of docs/ are looked for.
+CITING = ("src", "tests", "cpp", "plugin", "scenes", "tools", "bench", "examples", "build_backend",
+          "docs", "Makefile", "README.md", "pyproject.toml")
+TEXT_SUFFIXES = (".rs", ".h", ".cpp", ".py", ".md", ".toml", ".sh", ".xml", "")
+#: Citations of notes that are not part of the repository (replaced by docs/).
+STALE = re.compile(r"physics notes|notes on building|notes on Mitsuba|\(notes, section|seed eqs?\.")
+
+
+def plugin_docs():
+    spec = importlib.util.spec_from_file_location("plugin_docs", ROOT / "tools" / "plugin_docs.py")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules["plugin_docs"] = module  # dataclasses look their module up there
+    spec.loader.exec_module(module)
+    return module
+
+
+def text_files():
+    for entry in CITING:
+        path = ROOT / entry
+        paths = [path] if path.is_file() else path.rglob("*")
+        for p in paths:
+            if p.is_file() and "target" not in p.parts and p.suffix in TEXT_SUFFIXES:
+                yield p
+
+
+def test_architecture_map_lists_every_module():
+    text = (DOCS / "architecture.md").read_text()
+    mapped = re.findall(r"^- `([^`]+)` — \S", text, re.M)
+    assert len(mapped) == len(set(mapped)), "a module is listed twice"
+    existing = {str(p.relative_to(ROOT)) for g in MODULE_GLOBS for p in ROOT.glob(g) if p.is_file()}
+    existing = {p for p in existing if "__pycache__" not in p and not p.endswith(".so")}
+    missing, extra = sorted(existing - set(mapped)), sorted(set(mapped) - existing)
+    assert not missing, f"modules missing from the map: {missing}"
+    assert not extra, f"the map lists modules that do not exist: {extra}"
+
+
+def test_code_cites_only_existing_documents_and_sections():
+    cited = 0
+    for path in text_files():
+        text = path.read_text(errors="replace")
+        rel = path.relative_to(ROOT)
+        if rel != pathlib.Path("tests/python/test_docs.py"):
+            stale = STALE.findall(text)
+            assert not stale, f"{rel} cites notes outside the repository: {stale}"
+        for doc, section in re.findall(r"docs/(\w+)\.md(?:`)?(?:,? §(\d+))?", text):
+            cited += 1
+            target = DOCS / f"{doc}.md"
+            assert target.is_file(), f"{rel} cites docs/{doc}.md, which does not exist"
+            if section:
+                headings = re.findall(r"^## (\d+)\. ", target.read_text(), re.M)
+                assert section in headings, f"{rel} cites docs/{doc}.md §{section}: no such section"
+    assert cited > 10  # the search finds the citations
+
+
+def test_plugin_readme_tables_are_generated_from_the_sources():
+    result = subprocess.run([sys.executable, str(ROOT / "tools" / "plugin_docs.py"), "--check"],
+                            capture_output=True, text=True)
+    assert result.returncode == 0, result.stdout + result.stderr
+
+
+def source_names(path: pathlib.Path) -> tuple[set[str], set[str]]:
+    """(properties the plugin's constructor reads, parameters its `traverse` exposes)."""
+    source = path.read_text()
+    read = r'(?:props\.\w+(?:<[^>]*>)?\(|parse_ior\(props,\s*)\s*"(\w+)"'
+    names = set(re.findall(read, source))
+    if "parse_material(props" in source:  # common.h reads the material properties
+        common = (path.parent / "common.h").read_text()
+        body = common[common.index("inline MaterialParams parse_material"):]
+        names |= set(re.findall(read, body[:body.index("\n}\n")]))
+    exposed = set(re.findall(r'cb->put\("(\w+)"', source))
+    return names, exposed
+
+
+@pytest.mark.parametrize("plugin", ["thinbirefringent", "birefringent"])
+def test_documented_parameters_are_the_ones_the_plugin_reads(plugin):
+    path = ROOT / "cpp" / "src" / f"{plugin}.cpp"
+    name, params = plugin_docs().parameters(path.read_text())
+    assert name == plugin
+    read, exposed = source_names(path)
+    documented = {n for p in params for n in p.names()}
+    assert documented == read, f"documented {sorted(documented ^ read)} differ from those read"
+    marked = {n for p in params if "exposed" in p.flags for n in p.names()}
+    assert marked == exposed, f"exposed in the docs vs traverse: {sorted(marked ^ exposed)}"
+
+
+def test_plugin_docs_parser_reads_mitsuba_style_rows():
+    # The parser on a block in the format of Mitsuba's own plugins (multi-line cells, flags,
+    # the default at the end of the meaning, several names in one row).
+    block = """/**!
+
+Example plate (:monosp:`example`)
+---------------------------------
+
+.. pluginparameters::
+ :extra-rows: 1
+
+ * - eta_o, eta_e
+   - |float| or |texture|
+   - Indices of ``the`` plate,
+     continued. (Default: |false|)
+   - |exposed|, |differentiable|
+
+ * - flag
+   - |bool|
+   - On or off.
+
+Prose that is not a parameter.
+*/"""
+    name, params = plugin_docs().parameters(block)
+    assert name == "example"
+    assert [p.names() for p in params] == [["eta_o", "eta_e"], ["flag"]]
+    first = params[0]
+    assert (first.type, first.meaning, first.default, first.flags) == (
+        "float or texture", "Indices of `the` plate, continued.", "`false`",
+        "exposed, differentiable")
+    assert params[1].default == "—" and params[1].flags == ""
