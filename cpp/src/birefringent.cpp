@@ -61,8 +61,15 @@ public:
         m_types[0] = BSDFFlags::DeltaReflection;
         m_types[1] = m_types[2] = BSDFFlags::DeltaTransmission;
         m_components.clear();
-        for (BSDFFlags t : m_types)
-            m_components.push_back((uint32_t) t | sides);
+        // A lobe between different ray indices (a refraction; inside a birefringent crystal
+        // also a reflection that converts o into e) carries the radiance factor
+        // (n_wi / n_wo)^2 in its Radiance weight and not in its Importance weight:
+        // non-symmetric, as Mitsuba's `dielectric` declares its refraction.
+        for (size_t k = 0; k < 3; ++k) {
+            bool asym = k > 0 || !m_params.isotropic();
+            m_components.push_back((uint32_t) m_types[k] | sides |
+                                   (asym ? (uint32_t) BSDFFlags::NonSymmetric : 0u));
+        }
         m_flags = m_components[0] | m_components[1] | m_components[2];
 
         bfr_geometry g = geometry(m_optic_axis);

@@ -74,8 +74,11 @@ public:
             m_components.push_back((uint32_t) m_types[0] | (uint32_t) BSDFFlags::FrontSide | aniso);
             m_flags = m_components[0];
         } else {
+            // Between different indices the transmission's Radiance weight carries the radiance
+            // factor (n_wi / n_wo)^2 and its Importance weight does not (see birefringent.cpp).
+            uint32_t asym = m_exit_ior != m_ext_ior ? (uint32_t) BSDFFlags::NonSymmetric : 0u;
             m_components.push_back((uint32_t) m_types[0] | sides);
-            m_components.push_back((uint32_t) m_types[1] | sides);
+            m_components.push_back((uint32_t) m_types[1] | sides | asym);
             m_flags = m_components[0] | m_components[1];
         }
 

@@ -58,7 +58,12 @@ def test_flags_and_components():
     assert p.flags(1) == F.Null | sides
     assert p.flags() == p.flags(0) | p.flags(1)
     q = plate(material="quartz", thickness=10.0, exit_ior=1.5)
-    assert q.flags(1) == F.DeltaTransmission | sides
+    # Between different indices the Radiance weight carries the radiance factor: NonSymmetric
+    # (the Null transmission of p is symmetric, like thindielectric's).
+    assert q.flags(1) == F.DeltaTransmission | sides | F.NonSymmetric
+    si = surface_interaction(direction(40, 10))
+    w_r, w_i = (sample(q, context(m, 1), si)[1][0, 0, 0] for m in ("radiance", "importance"))
+    assert w_r / w_i == pytest.approx((1.000277 / 1.5) ** 2, rel=1e-6)  # ext_ior "air"
     iso = plate(eta_o=1.5, eta_e=1.5)
     assert not iso.flags() & F.Anisotropic
     si = surface_interaction(direction(40, 10))
