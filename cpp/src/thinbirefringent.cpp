@@ -28,13 +28,16 @@ public:
                          ? bfr::parse_ior(props, "exit_ior", "air", ClassName)
                          : m_ext_ior;
         m_optic_axis = props.get<ScalarVector3f>("optic_axis", ScalarVector3f(1.f, 0.f, 0.f));
-        m_thickness = props.get_unbounded_texture<Texture>("thickness", 1.f);
+        m_thickness = bfr::scalar_texture<Float, Spectrum>(props, "thickness", 1.0,
+                                                           "micrometres", ClassName);
         m_thickness_scale = props.get<double>("thickness_scale", 1.0);
         if (props.has_property("birefringence"))
-            m_birefringence = props.get_unbounded_texture<Texture>("birefringence", 0.f);
+            m_birefringence = bfr::scalar_texture<Float, Spectrum>(
+                props, "birefringence", 0.0, "added to eta_e", ClassName);
         m_birefringence_scale = props.get<double>("birefringence_scale", 1.0);
         if (props.has_property("axis_angle"))
-            m_axis_angle = props.get_unbounded_texture<Texture>("axis_angle", 0.f);
+            m_axis_angle = bfr::scalar_texture<Float, Spectrum>(props, "axis_angle", 0.0,
+                                                                "degrees", ClassName);
         m_filter_bandwidth = props.get<double>("filter_bandwidth", DefaultFilterBandwidth);
         m_absorbing_exit = props.get<bool>("absorbing_exit", false);
         parameters_changed();

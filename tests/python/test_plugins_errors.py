@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 
 import mitsuba as mi
@@ -46,6 +47,39 @@ PLATE_CASES = [
     ({"birefringence": math.nan}, "birefringence"),
     ({"eta_o": 1.5, "eta_e": 1.5, "birefringence": -2.0}, "birefringence"),
 ]
+
+
+# A physical scalar given as a colour: refused in every variant, with how to give it.
+COLOUR_VALUES = {
+    "rgb": {"type": "rgb", "value": [30.0, 30.0, 31.0]},
+    "spectrum": {"type": "spectrum", "value": [(400.0, 30.0), (700.0, 31.0)]},
+    "srgb texture": {"type": "srgb", "color": [0.5, 0.5, 0.5]},
+    "string": "thick",
+}
+
+
+@pytest.mark.parametrize("name", ["scalar_rgb", "scalar_spectral", POLARIZED])
+@pytest.mark.parametrize("param", ["thickness", "axis_angle", "birefringence"])
+@pytest.mark.parametrize("kind", sorted(COLOUR_VALUES))
+def test_scalar_parameter_given_as_a_colour_is_refused(name, param, kind):
+    variant(name)
+    with pytest.raises(RuntimeError) as e:
+        load("thinbirefringent", {"material": "quartz", param: COLOUR_VALUES[kind]})
+    text = str(e.value)
+    assert f'"{param}"' in text and 'raw="true"' in text and "give a float" in text, text
+
+
+@pytest.mark.parametrize("name", ["scalar_spectral", POLARIZED])
+def test_colour_bitmap_is_refused_at_load_in_spectral_variants(name):
+    """A 3-channel bitmap without raw="true" holds upsampled spectra in the spectral variants
+    and Mitsuba refuses its eval_1: refused at load, naming the parameter (before: an
+    exception at the first hit, in the middle of a render). With raw="true" it loads."""
+    variant(name)
+    data = mi.Bitmap(np.full((2, 2, 3), 3.0, dtype=np.float32))
+    with pytest.raises(RuntimeError, match='"thickness".*raw="true"'):
+        load("thinbirefringent", {"material": "quartz", "thickness": {"type": "bitmap", "bitmap": data}})
+    load("thinbirefringent", {"material": "quartz",
+                              "thickness": {"type": "bitmap", "bitmap": data, "raw": True}})
 
 
 def load(kind, params):
