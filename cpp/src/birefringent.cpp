@@ -47,8 +47,15 @@ public:
         cb->put("optic_axis", m_optic_axis, ParamFlags::NonDifferentiable);
     }
 
-    /// Rebuilds the core material and the flags, and checks every parameter with one core query.
+    /// Applies changed parameters; a rejected update leaves the last valid state in force
+    /// (bfr::update_or_restore).
     void parameters_changed(const std::vector<std::string> & /*keys*/ = {}) override {
+        bfr::update_or_restore<Float, Spectrum>(this, m_valid, [this] { rebuild(); });
+    }
+
+private:
+    /// Rebuilds the core material and the flags, and checks every parameter with one core query.
+    void rebuild() {
         if (!is_polarized_v<Spectrum> && !m_params.isotropic())
             Throw("double refraction (eta_o != eta_e, or a named crystal: %s) needs a polarized "
                   "variant, which carries whether a ray in the crystal is ordinary or "
@@ -82,6 +89,7 @@ public:
             Throw("%s", bfr::core_error(rc, message));
     }
 
+public:
     std::pair<BSDFSample3f, Spectrum> sample(const BSDFContext &ctx, const SurfaceInteraction3f &si,
                                              Float sample1, const Point2f & /*sample2*/,
                                              Mask active) const override {
@@ -161,6 +169,7 @@ private:
     bool m_axis_in_world = false;
     BSDFFlags m_types[3];
     mutable std::atomic<bool> m_warned { false };
+    std::unique_ptr<bfr::Snapshot<Float, Spectrum>> m_valid;  ///< last valid state
 
     MI_TRAVERSE_CB(Base)
 };

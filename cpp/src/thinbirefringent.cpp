@@ -63,9 +63,16 @@ public:
         cb->put("filter_bandwidth", m_filter_bandwidth, ParamFlags::NonDifferentiable);
     }
 
+    /// Applies changed parameters; a rejected update leaves the last valid state in force
+    /// (bfr::update_or_restore).
+    void parameters_changed(const std::vector<std::string> & /*keys*/ = {}) override {
+        bfr::update_or_restore<Float, Spectrum>(this, m_valid, [this] { rebuild(); });
+    }
+
+private:
     /// Rebuilds the core material and the flags, and checks every parameter with one core query
     /// (textures at their mean), so that invalid input fails here, with the core's message.
-    void parameters_changed(const std::vector<std::string> & /*keys*/ = {}) override {
+    void rebuild() {
         m_material = bfr::make_material(m_params, ClassName);
         m_null = m_exit_ior == m_ext_ior && !m_absorbing_exit;
         uint32_t aniso = (m_params.isotropic() && !m_birefringence) ? 0u : (uint32_t) BSDFFlags::Anisotropic;
@@ -97,6 +104,7 @@ public:
             Throw("%s", bfr::core_error(rc, message));
     }
 
+public:
     std::pair<BSDFSample3f, Spectrum> sample(const BSDFContext &ctx, const SurfaceInteraction3f &si,
                                              Float sample1, const Point2f & /*sample2*/,
                                              Mask active) const override {
@@ -214,6 +222,7 @@ private:
     bool m_null = true, m_absorbing_exit = false;
     BSDFFlags m_types[2];
     mutable std::atomic<bool> m_warned { false };
+    std::unique_ptr<bfr::Snapshot<Float, Spectrum>> m_valid;  ///< last valid state
 
     MI_TRAVERSE_CB(Base, m_thickness, m_birefringence, m_axis_angle)
 };
