@@ -8,6 +8,7 @@
  * bfr_plate_lobes / bfr_plate_lobes_rgb.
  */
 #include "common.h"
+#include "signed_rgb.h"
 
 NAMESPACE_BEGIN(mitsuba)
 
@@ -222,6 +223,7 @@ private:
     bool m_null = true, m_absorbing_exit = false;
     BSDFFlags m_types[2];
     mutable std::atomic<bool> m_warned { false };
+    bfr::SignedRgbGuard m_signed_rgb { is_rgb_v<Spectrum> };  ///< see signed_rgb.h
     std::unique_ptr<bfr::Snapshot<Float, Spectrum>> m_valid;  ///< last valid state
 
     MI_TRAVERSE_CB(Base, m_thickness, m_birefringence, m_axis_angle)
