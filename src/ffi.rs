@@ -9,6 +9,7 @@ use crate::error::{Error, Result};
 use crate::material::Material;
 use crate::optics::medium::Uniaxial;
 use crate::optics::surface::Surface;
+use crate::params::{Length, Thickness};
 use crate::render::crystal::crystal_lobes;
 use crate::render::plate::{plate_lobes, PlateQuery, Spectrum, MAX_BANDS};
 use crate::render::{PathLobe, Transport};
@@ -324,7 +325,7 @@ fn plate_query(m: &Material, g: &BfrGeometry, flags: i32) -> Result<PlateQuery> 
         C64::new(g.ext_ior, 0.0),
         C64::new(g.exit_ior, 0.0),
         Vector3::from(g.optic_axis),
-        g.thickness_nm,
+        Thickness::new("thickness", g.thickness_nm, Length::Micrometres)?,
         flags & BFR_WANT_REFLECTION != 0,
         flags & BFR_WANT_TRANSMISSION != 0,
         flags & BFR_INTENSITY_ONLY != 0,

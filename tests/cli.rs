@@ -253,3 +253,33 @@ fn an_evanescent_incident_wave_is_refused() {
     let e = v["error"].as_str().unwrap();
     assert!(e.starts_with("incidence:") && e.contains("no power"), "{e}");
 }
+
+/// Every message names the field the user wrote, in the field's unit: a plate thicker than 1 m
+/// is `thickness_um` in µm (it was the core's `thickness` in nm), a band wider than a quarter
+/// of the wavelength is `spectrum.bandwidth_nm` with the limit at this wavelength.
+#[test]
+fn slab_range_errors_name_the_field_in_its_unit() {
+    let cases = [
+        (
+            r#""thickness_um": 2e6"#,
+            "thickness_um: must be within [0, 1e6] µm (1 m), got 2000000 µm",
+        ),
+        (
+            r#""thickness_um": -2"#,
+            "thickness_um: must be within [0, 1e6] µm (1 m), got -2 µm",
+        ),
+        (
+            r#""thickness_um": 12, "spectrum": {"bandwidth_nm": 150}"#,
+            "spectrum.bandwidth_nm: must be within [0, 137.5] nm (a quarter of the wavelength 550 nm), got 150 nm",
+        ),
+    ];
+    for (fields, want) in cases {
+        let input = format!(
+            r#"{{"wavelength_nm": 550, "eta_o": 1.5, "eta_e": 1.6, "optic_axis": [1,0,0], "theta_deg": 0, {fields}}}"#
+        );
+        let (code, out) = run(&["slab"], &input);
+        assert_eq!(code, 1, "{fields}");
+        let v: Value = serde_json::from_str(&out).unwrap();
+        assert_eq!(v["error"].as_str().unwrap(), want, "{fields}");
+    }
+}

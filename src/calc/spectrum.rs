@@ -7,6 +7,7 @@ use super::output::num;
 use super::slab::{matrix, read, SlabQuery};
 use crate::band::{is_exact_band, narrow_band};
 use crate::error::{Error, Result};
+use crate::params::Bandwidth;
 use crate::plate::slab::Output;
 use crate::plate::slab::{SlabMueller, Want};
 use crate::spectral::integrate::{integrate, integrate_set, quadrature};
@@ -81,13 +82,12 @@ pub fn run(input: &Value, fields: &[&str], spec: &Value) -> Result<Value> {
                 )
             }
             (None, Some(b)) => {
-                if !(0.0..=0.25 * q.wavelength_nm).contains(&b) {
-                    return Err(Error::new(
-                        "spectrum.bandwidth_nm",
-                        format!("must be within [0, wavelength_nm / 4], got {b}"),
-                    ));
-                }
-                let m = band(&q, b, quad, step)?;
+                let m = band(
+                    &q,
+                    Bandwidth::new("spectrum.bandwidth_nm", b, q.wavelength_nm)?,
+                    quad,
+                    step,
+                )?;
                 (
                     vec![format!("{} nm ± {b} nm FWHM", q.wavelength_nm)],
                     vec![m],
@@ -149,7 +149,8 @@ fn power(m: &Matrix4<f64>, input: f64, output: f64) -> f64 {
 }
 
 /// A Gaussian band of FWHM `b` around the query's wavelength.
-fn band(q: &SlabQuery, b: f64, quad: bool, step: Option<f64>) -> Result<SlabMueller> {
+fn band(q: &SlabQuery, b: Bandwidth, quad: bool, step: Option<f64>) -> Result<SlabMueller> {
+    let b = b.fwhm_nm();
     if is_exact_band(b, q.wavelength_nm) {
         return q
             .slab
