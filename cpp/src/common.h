@@ -120,6 +120,9 @@ inline double parse_ior(const Properties &props, const std::string &name,
         auto type = props.type(name);
         if (type == Properties::Type::Float || type == Properties::Type::Integer)
             return props.get<double>(name);
+        if (type != Properties::Type::String)
+            Throw("\"%s\" must be a float (a real index) or one of Mitsuba's IOR names (e.g. "
+                  "\"water\"), got %s", name, property_type_name(type));
     }
     try {
         return (double) lookup_ior(props, name, default_name);
@@ -171,7 +174,7 @@ ref<Texture<Float, Spectrum>> scalar_texture(const Properties &props, const std:
         case Properties::Type::Object:
             break;
         default:
-            Throw("\"%s\" must be a float (%s) or a texture, got a %s; %s", name, unit,
+            Throw("\"%s\" must be a float (%s) or a texture, got %s; %s", name, unit,
                   property_type_name(props.type(name)), how);
     }
     ref<Tex> tex = props.get_unbounded_texture<Tex>(name);

@@ -93,8 +93,11 @@ private:
             m_flags = m_components[0] | m_components[1];
         }
 
-        bfr_geometry g = geometry(m_thickness->mean(), m_birefringence ? m_birefringence->mean() : 0.0,
-                                  m_axis_angle ? m_axis_angle->mean() : 0.0);
+        bfr_geometry g;
+        std::string error;
+        if (!geometry(m_thickness->mean(), m_birefringence ? m_birefringence->mean() : 0.0,
+                      m_axis_angle ? m_axis_angle->mean() : 0.0, g, error))
+            Throw("%s", error);
         const double wi[3] = { 0.0, 0.0, 1.0 };
         bfr_path_lobe out[2];
         char message[bfr::MessageLen] = { 0 };
@@ -164,25 +167,39 @@ public:
 
 private:
     /// Geometry from the texture values: thickness (um, before scaling), birefringence (before
-    /// scaling), axis angle (degrees).
-    bfr_geometry geometry(double thickness_um, double birefringence, double angle_deg) const {
-        bfr_geometry g{};
+    /// scaling), axis angle (degrees). False, with the message in `error`, if the angle is not
+    /// a finite number: the core sees only the rotated axis and would name `optic_axis`.
+    bool geometry(double thickness_um, double birefringence, double angle_deg, bfr_geometry &g,
+                  std::string &error) const {
+        if (!std::isfinite(angle_deg)) {
+            error = "axis_angle: must be a finite number (degrees), got " + std::to_string(angle_deg);
+            return false;
+        }
+        g = bfr_geometry{};
         g.ext_ior = m_ext_ior;
         g.exit_ior = m_exit_ior;
         const double axis[3] = { m_optic_axis.x(), m_optic_axis.y(), m_optic_axis.z() };
         bfr::rotate_about_normal(axis, angle_deg, g.optic_axis);
         g.thickness_nm = 1000.0 * m_thickness_scale * thickness_um;
         g.birefringence = m_birefringence_scale * birefringence;
-        return g;
+        return true;
     }
 
     /// Core query at si: lobes[ch * 2 + i] for channel ch, lobe i (0 R, 1 T). False (after one
     /// warning) if the core refuses, e.g. a texture gives a negative thickness.
     bool query(const SurfaceInteraction3f &si, TransportMode mode, int32_t want,
                bfr_path_lobe *lobes) const {
-        bfr_geometry g = geometry(m_thickness->eval_1(si),
-                                  m_birefringence ? (double) m_birefringence->eval_1(si) : 0.0,
-                                  m_axis_angle ? (double) m_axis_angle->eval_1(si) : 0.0);
+        auto refuse = [this](const std::string &error) {
+            if (!m_warned.exchange(true))
+                Log(Warn, "%s (returning no light; further errors are not reported)", error);
+            return false;
+        };
+        bfr_geometry g;
+        std::string error;
+        if (!geometry(m_thickness->eval_1(si),
+                      m_birefringence ? (double) m_birefringence->eval_1(si) : 0.0,
+                      m_axis_angle ? (double) m_axis_angle->eval_1(si) : 0.0, g, error))
+            return refuse(error);
         const double wi[3] = { si.wi.x(), si.wi.y(), si.wi.z() };
         int32_t transport = mode == TransportMode::Radiance ? BFR_RADIANCE : BFR_IMPORTANCE;
         int32_t flags = want | (is_polarized_v<Spectrum> ? 0 : BFR_INTENSITY_ONLY) |
@@ -205,12 +222,8 @@ private:
                                    m_filter_bandwidth, wi, transport, flags, lobes, message,
                                    sizeof(message));
         }
-        if (rc != BFR_OK) {
-            if (!m_warned.exchange(true))
-                Log(Warn, "%s (returning no light; further errors are not reported)",
-                    bfr::core_error(rc, message));
-            return false;
-        }
+        if (rc != BFR_OK)
+            return refuse(bfr::core_error(rc, message));
         return true;
     }
 

@@ -45,6 +45,8 @@ PLATE_CASES = [
     ({"filter_bandwidth": -2.0}, "filter_bandwidth"),
     ({"filter_bandwidth": math.nan}, "filter_bandwidth"),
     ({"birefringence": math.nan}, "birefringence"),
+    ({"axis_angle": math.nan}, "axis_angle"),
+    ({"axis_angle": math.inf}, "axis_angle"),
     ({"eta_o": 1.5, "eta_e": 1.5, "birefringence": -2.0}, "birefringence"),
 ]
 
@@ -80,6 +82,40 @@ def test_colour_bitmap_is_refused_at_load_in_spectral_variants(name):
         load("thinbirefringent", {"material": "quartz", "thickness": {"type": "bitmap", "bitmap": data}})
     load("thinbirefringent", {"material": "quartz",
                               "thickness": {"type": "bitmap", "bitmap": data, "raw": True}})
+
+
+# Messages name the parameter the user wrote, in the user's unit (not the core's name, unit or
+# the Mitsuba type it was read as).
+EXACT_MESSAGES = [
+    ({"axis_angle": math.nan}, "axis_angle: must be a finite number (degrees), got nan", "optic_axis"),
+    ({"ext_ior": {"type": "rgb", "value": [1.5, 1.5, 1.5]}},
+     '"ext_ior" must be a float (a real index) or one of Mitsuba\'s IOR names', "expected string"),
+    ({"exit_ior": [1.0, 2.0, 3.0]},
+     '"exit_ior" must be a float (a real index) or one of Mitsuba\'s IOR names', "expected string"),
+    ({"thickness": 2e6}, "thickness: must be within [0, 1e6] µm (1 m), got 2000000 µm", " nm"),
+    ({"filter_bandwidth": 200.0},
+     "filter_bandwidth: must be within [0, 137.5] nm (a quarter of the wavelength 550 nm), got 200 nm",
+     "wavelength /"),
+]
+
+
+@pytest.mark.parametrize("params,want,not_want", EXACT_MESSAGES)
+def test_message_names_what_the_user_wrote(params, want, not_want):
+    variant(POLARIZED)
+    with pytest.raises(RuntimeError) as e:
+        load("thinbirefringent", {"material": "quartz", **params})
+    assert want in str(e.value) and not_want not in str(e.value), str(e.value)
+
+
+def test_axis_angle_bitmap_with_nan_is_named():
+    """An axis-angle bitmap with a NaN cell (its mean, the load check's value, is NaN) is
+    refused naming axis_angle, not the optic axis the shim rotates with it."""
+    variant(POLARIZED)
+    angle = mi.Bitmap(np.array([[30.0, math.nan]], dtype=np.float32))
+    with pytest.raises(RuntimeError) as e:
+        load("thinbirefringent", {"material": "quartz",
+                                  "axis_angle": {"type": "bitmap", "bitmap": angle, "raw": True}})
+    assert "axis_angle: must be a finite number" in str(e.value), str(e.value)
 
 
 def load(kind, params):
