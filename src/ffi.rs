@@ -6,7 +6,7 @@
 //! naming the parameter; a non-finite result is reported as `BFR_INTERNAL`, never returned.
 
 use crate::error::{Error, Result};
-use crate::material::Material;
+use crate::material::{check_kappa, Material};
 use crate::optics::medium::Uniaxial;
 use crate::optics::surface::Surface;
 use crate::params::{Length, Thickness};
@@ -153,14 +153,8 @@ fn null(name: &str) -> Error {
 
 fn material_from(desc: &BfrMaterialDesc) -> Result<Material> {
     if desc.material.is_null() {
-        for (name, k) in [("kappa_o", desc.kappa_o), ("kappa_e", desc.kappa_e)] {
-            if !(k.is_finite() && k >= 0.0) {
-                return Err(Error::new(
-                    name,
-                    format!("must be finite and >= 0, got {k}"),
-                ));
-            }
-        }
+        check_kappa("kappa_o", desc.kappa_o)?;
+        check_kappa("kappa_e", desc.kappa_e)?;
         let eo = c64(desc.eta_o) + C64::new(0.0, desc.kappa_o);
         let ee = c64(desc.eta_e) + C64::new(0.0, desc.kappa_e);
         return Material::constant(eo, ee);

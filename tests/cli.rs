@@ -227,6 +227,14 @@ fn slab_errors_name_the_field() {
         ),
         (r#", "exit_ior": -1"#, "exit_ior"),
         (r#", "side": "inside""#, "side"),
+        // fields of the nested spectrum object keep its name (they were `bandwidth_nm`,
+        // `spectrum.input`)
+        (
+            r#", "spectrum": {"bandwidth_nm": "x"}"#,
+            "spectrum.bandwidth_nm",
+        ),
+        (r#", "spectrum": {"weights": 3}"#, "spectrum.weights"),
+        (r#", "spectrum": 3"#, "spectrum"),
     ];
     for (extra, field) in cases {
         let (code, v) = slab(extra);

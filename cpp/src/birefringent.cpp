@@ -37,7 +37,7 @@ public:
     }
 
     void traverse(TraversalCallback *cb) override {
-        if (m_params.material.empty()) {
+        if (!m_params.named) {
             cb->put("eta_o", m_params.eta_o, ParamFlags::NonDifferentiable);
             cb->put("eta_e", m_params.eta_e, ParamFlags::NonDifferentiable);
         }

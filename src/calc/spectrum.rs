@@ -22,8 +22,11 @@ const RANGE: (f64, f64) = (360.0, 830.0);
 pub fn run(input: &Value, fields: &[&str], spec: &Value) -> Result<Value> {
     let mut f = Fields::new(input, fields)?;
     let q = read(&mut f)?;
-    let mut s = Fields::new(spec, &["weights", "method", "step_nm", "bandwidth_nm"])
-        .map_err(|e| Error::new(format!("spectrum.{}", e.parameter), e.message))?;
+    let mut s = Fields::nested(
+        spec,
+        &["weights", "method", "step_nm", "bandwidth_nm"],
+        "spectrum",
+    )?;
     let method = s.string("method")?.unwrap_or("analytic");
     if !matches!(method, "analytic" | "quadrature") {
         return Err(Error::new(

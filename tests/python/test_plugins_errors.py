@@ -26,6 +26,9 @@ COMMON_CASES = [
     ({"material": "calcite", "eta_o": 1.5, "eta_e": 1.6}, "material"),
     ({"material": "calcite", "kappa_o": -0.1}, "kappa_o"),
     ({"material": "calcite", "kappa_e": math.nan}, "kappa_e"),
+    ({"material": "calcite", "kappa_e": 1e300}, "kappa_e"),  # was named eta_e
+    ({"eta_o": 1.5, "eta_e": 1.5, "kappa_o": 1e4}, "kappa_o"),  # was named eta_o
+    ({"material": ""}, "material"),  # was read as constant indices 0: eta_o
     ({"material": "calcite", "optic_axis": [0, 0, 0]}, "optic_axis"),
     ({"material": "calcite", "optic_axis": [math.nan, 0, 1]}, "optic_axis"),
     ({"material": "calcite", "optic_axis": "up"}, "optic_axis"),
@@ -105,6 +108,14 @@ def test_message_names_what_the_user_wrote(params, want, not_want):
     with pytest.raises(RuntimeError) as e:
         load("thinbirefringent", {"material": "quartz", **params})
     assert want in str(e.value) and not_want not in str(e.value), str(e.value)
+
+
+@pytest.mark.parametrize("kappa", ["kappa_o", "kappa_e"])
+def test_absorbing_birefringent_crystal_names_the_kappa_given(kappa):
+    variant(POLARIZED)
+    with pytest.raises(RuntimeError) as e:
+        load("birefringent", {"material": "calcite", kappa: 0.1})
+    assert f"{kappa}: an absorbing birefringent crystal" in str(e.value), str(e.value)
 
 
 def test_axis_angle_bitmap_with_nan_is_named():
