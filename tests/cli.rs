@@ -291,3 +291,27 @@ fn slab_range_errors_name_the_field_in_its_unit() {
         assert_eq!(v["error"].as_str().unwrap(), want, "{fields}");
     }
 }
+
+/// An extinction coefficient beyond the accepted range is named as written (`kappa_o`,
+/// `kappa_e`), for a named crystal and for constant indices (it was the core's `eta_e` /
+/// `eta_o`, the index it is added to).
+#[test]
+fn kappa_errors_name_the_kappa() {
+    for (fields, want) in [
+        (
+            r#""material": "quartz", "kappa_e": 2e3"#,
+            "kappa_e: must be within [0, 1000], got 2000",
+        ),
+        (
+            r#""eta_o": 1.5, "eta_e": 1.6, "kappa_o": 1e4"#,
+            "kappa_o: must be within [0, 1000], got 10000",
+        ),
+    ] {
+        let input =
+            format!(r#"{{"wavelength_nm": 550, "optic_axis": [1,0,0], "theta_deg": 0, {fields}}}"#);
+        let (code, out) = run(&["interface"], &input);
+        assert_eq!(code, 1, "{fields}");
+        let v: Value = serde_json::from_str(&out).unwrap();
+        assert_eq!(v["error"].as_str().unwrap(), want, "{fields}");
+    }
+}
