@@ -235,6 +235,11 @@ fn slab_errors_name_the_field() {
         ),
         (r#", "spectrum": {"weights": 3}"#, "spectrum.weights"),
         (r#", "spectrum": 3"#, "spectrum"),
+        // the quadrature's own step limit (it was the bare `step_nm`)
+        (
+            r#", "spectrum": {"bandwidth_nm": 100, "method": "quadrature", "step_nm": 1e-6}"#,
+            "spectrum.step_nm",
+        ),
     ];
     for (extra, field) in cases {
         let (code, v) = slab(extra);

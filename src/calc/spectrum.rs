@@ -73,6 +73,7 @@ pub fn run(input: &Value, fields: &[&str], spec: &Value) -> Result<Value> {
                                 step,
                                 Want::BOTH,
                             )
+                            .map_err(step_field)
                         })
                         .collect::<Result<Vec<_>>>()?
                 } else {
@@ -187,6 +188,16 @@ fn band(q: &SlabQuery, b: Bandwidth, quad: bool, step: Option<f64>) -> Result<Sl
         step.unwrap_or_else(|| auto_step(q, range.0)),
         Want::BOTH,
     )
+    .map_err(step_field)
+}
+
+/// The quadrature's error about its step under the name of the field that sets it.
+fn step_field(e: Error) -> Error {
+    if e.parameter == "step_nm" {
+        Error::new("spectrum.step_nm", e.message)
+    } else {
+        e
+    }
 }
 
 /// A quadrature step resolving the fringes of up to ~10 internal round trips at the shortest

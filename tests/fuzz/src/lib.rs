@@ -293,9 +293,11 @@ pub fn calc_document(b: &mut Bytes, slab: bool) -> String {
 
 /// What a calculator error `e` may name (the text before its ": "): a field of the document
 /// (e.g. an unknown one), a field of the calculator (e.g. a missing one; an element `[i]` of a
-/// vector field), `spectrum.<field>` for a field of the spectrum object, or the subject of an
-/// error about the whole input (`input`, `incidence`, `spectrum`, `subcommand`) — never a name
-/// of the core the user did not write (as `thickness` in nm for `thickness_um` once was).
+/// vector field), `spectrum.<field>` for a field of the spectrum object, the subject of an
+/// error about the whole input (`input`, `incidence`, `spectrum`, `subcommand`), or the object
+/// of a physically undefined query (`slab`: a diverging multiple-reflection sum, `interface`: a
+/// singular boundary system) — never a name of the core the user did not write (as
+/// `thickness` in nm for `thickness_um` once was).
 fn names_what_the_user_wrote(e: &str, text: &str) -> bool {
     let doc: Value = serde_json::from_str(text).unwrap_or(Value::Null);
     let keys = |v: &Value| -> Vec<String> {
@@ -313,7 +315,17 @@ fn names_what_the_user_wrote(e: &str, text: &str) -> bool {
             .chain(spectrum)
             .map(|k| format!("spectrum.{k}")),
     );
-    names.extend(["input", "incidence", "spectrum", "subcommand"].map(String::from));
+    names.extend(
+        [
+            "input",
+            "incidence",
+            "spectrum",
+            "subcommand",
+            "slab",
+            "interface",
+        ]
+        .map(String::from),
+    );
     names
         .iter()
         .any(|n| e.starts_with(&format!("{n}: ")) || e.starts_with(&format!("{n}[")))
