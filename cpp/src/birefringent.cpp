@@ -11,6 +11,7 @@
  * bfr_crystal_lobes. Parameters: see plugin/README.md.
  */
 #include "common.h"
+#include "last_valid.h"
 
 NAMESPACE_BEGIN(mitsuba)
 

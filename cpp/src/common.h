@@ -8,7 +8,6 @@
 #pragma once
 
 #include <optional>
-#include <drjit/tensor.h>
 #include <mitsuba/core/plugin.h>
 #include <mitsuba/core/properties.h>
 #include <mitsuba/core/string.h>
@@ -20,12 +19,9 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <functional>
 #include <memory>
 #include <sstream>
 #include <string>
-#include <typeinfo>
-#include <vector>
 
 #include "birefringent.h"
 
@@ -131,141 +127,6 @@ inline double parse_ior(const Properties &props, const std::string &name,
     } catch (const std::exception &e) {
         Throw("\"%s\": %s", name, e.what());
     }
-}
-
-/** A physical scalar that may vary over the surface (`thickness`, `birefringence`,
- * `axis_angle`), read with `eval_1` at each hit: a float, a uniform spectrum, a grey rgb (equal
- * channels: that value, exactly), or a texture of data values (a bitmap with raw="true", a
- * checkerboard of floats, ...). Refused at load, with `unit` and how to give the value: an rgb
- * with unequal channels, a spectrum varying with wavelength, and a colour texture (srgb,
- * spectra, or a bitmap that Mitsuba upsamples to spectra): Mitsuba reads those for a scalar
- * parameter as a colour, not as the number (in the spectral variants an rgb becomes a smooth
- * reflectance spectrum bounded to [0, 1], so rgb 30 would read as ~1). */
-template <typename Float, typename Spectrum>
-ref<Texture<Float, Spectrum>> scalar_texture(const Properties &props, const std::string &name,
-                                             double def, const char *unit,
-                                             const char *ClassName) {
-    using Tex = Texture<Float, Spectrum>;
-    const char *how = "give a float, or a texture of data values such as a bitmap with "
-                      "raw=\"true\"";
-    auto uniform = [&](double value) {
-        props.mark_queried(name);
-        Properties p("uniform");
-        p.set("value", value);
-        return ref<Tex>(PluginManager::instance()->create_object<Tex>(p));
-    };
-    if (!props.has_property(name))
-        return uniform(def);
-    switch (props.type(name)) {
-        case Properties::Type::Color: {
-            auto c = props.get<Color<double, 3>>(name);
-            if (c.r() != c.g() || c.r() != c.b())
-                Throw("\"%s\" is a number (%s), not a colour: got rgb %s; %s", name, unit,
-                      c, how);
-            return uniform(c.r());
-        }
-        case Properties::Type::Spectrum: {
-            const auto &s = props.get<Properties::Spectrum>(name);
-            if (!s.is_uniform())
-                Throw("\"%s\" is a number (%s), not a spectrum varying with wavelength; %s",
-                      name, unit, how);
-            return uniform(s.values[0]);
-        }
-        case Properties::Type::Float:
-        case Properties::Type::Integer:
-        case Properties::Type::Object:
-            break;
-        default:
-            Throw("\"%s\" must be a float (%s) or a texture, got %s; %s", name, unit,
-                  property_type_name(props.type(name)), how);
-    }
-    ref<Tex> tex = props.get_unbounded_texture<Tex>(name);
-    static const char *colour_classes[] = { "SRGBReflectanceSpectrum", "RegularSpectrum",
-                                            "IrregularSpectrum", "D65Spectrum",
-                                            "BlackBodySpectrum" };
-    for (const char *c : colour_classes)
-        if (tex->class_name() == c)
-            Throw("\"%s\" is a number (%s), not a colour or a spectrum (got a %s texture); %s",
-                  name, unit, c, how);
-    // A bitmap Mitsuba converts into spectra (3 channels, raw="false", spectral variants)
-    // refuses eval_1: find out now rather than at the first hit.
-    try {
-        SurfaceInteraction<Float, Spectrum> si = dr::zeros<SurfaceInteraction<Float, Spectrum>>();
-        si.uv = Point<Float, 2>(0.5f, 0.5f);
-        (void) tex->eval_1(si);
-    } catch (const std::exception &) {
-        Throw("\"%s\" is a number (%s), but its texture holds colours (a bitmap without "
-              "raw=\"true\" is converted into spectra in this variant); %s", name, unit, how);
-    }
-    return tex;
-}
-
-/** The values an object exposes to `mi.traverse`, its own and its textures' (recursively),
- * saved so that they can be put back: the last valid state of a plugin, restored when an
- * update is rejected. Values of other types than those listed in `put_value` (none of the
- * plugins' or of Mitsuba's uniform, checkerboard and bitmap textures) are not saved. */
-template <typename Float, typename Spectrum> class Snapshot final : public TraversalCallback {
-public:
-    MI_IMPORT_CORE_TYPES()
-
-    explicit Snapshot(Object *root) { root->traverse(this); }
-
-    /// Writes the saved values back, then lets each saved texture rebuild itself (deepest
-    /// first). The root object itself is left to the caller.
-    void restore() {
-        for (const auto &r : m_restore)
-            r();
-        for (auto it = m_children.rbegin(); it != m_children.rend(); ++it)
-            (*it)->parameters_changed();
-    }
-
-protected:
-    void put_value(std::string_view, void *value, uint32_t, const std::type_info &type) override {
-        (void) (save<double>(value, type) || save<float>(value, type) ||
-                save<bool>(value, type) || save<int32_t>(value, type) ||
-                save<uint32_t>(value, type) || save<ScalarVector3f>(value, type) ||
-                save<ScalarPoint3f>(value, type) || save<ScalarColor3f>(value, type) ||
-                save<ScalarAffineTransform3f>(value, type) || save<TensorXf>(value, type));
-    }
-
-    void put_object(std::string_view, Object *object, uint32_t) override {
-        if (!object)
-            return;
-        m_children.push_back(object);
-        object->traverse(this);
-    }
-
-private:
-    template <typename T> bool save(void *value, const std::type_info &type) {
-        if (type != typeid(T))
-            return false;
-        T *p = static_cast<T *>(value);
-        m_restore.push_back([p, saved = *p] { *p = saved; });
-        return true;
-    }
-
-    std::vector<std::function<void()>> m_restore;
-    std::vector<ref<Object>> m_children;
-};
-
-/** `parameters_changed` of a plugin: `rebuild` validates every parameter and derives the
- * internal state, throwing on invalid input. On success the traversed values become the last
- * valid state; on failure that state is put back and rebuilt before the error propagates, so a
- * rejected update (`mi.traverse(...)` values set, then `update()` raises) changes nothing: the
- * plugin renders and traverses as before it. */
-template <typename Float, typename Spectrum, typename Rebuild>
-void update_or_restore(Object *self, std::unique_ptr<Snapshot<Float, Spectrum>> &valid,
-                       Rebuild &&rebuild) {
-    try {
-        rebuild();
-    } catch (...) {
-        if (valid) {
-            valid->restore();
-            rebuild();
-        }
-        throw;
-    }
-    valid = std::make_unique<Snapshot<Float, Spectrum>>(self);
 }
 
 /// Rotates `v` about the local normal (z) by `degrees`, counter-clockwise seen from +z

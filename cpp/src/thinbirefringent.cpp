@@ -8,6 +8,8 @@
  * bfr_plate_lobes / bfr_plate_lobes_rgb.
  */
 #include "common.h"
+#include "last_valid.h"
+#include "scalar_texture.h"
 #include "signed_rgb.h"
 
 NAMESPACE_BEGIN(mitsuba)
