@@ -38,6 +38,7 @@ use birefringent::material::Material;
 use birefringent::optics::frame::PlaneFrame;
 use birefringent::optics::interface::Interface;
 use birefringent::optics::medium::Uniaxial;
+use birefringent::params::Thickness;
 use birefringent::plate::slab::Output;
 use birefringent::plate::slab::{Slab, SlabOptics, Want};
 use birefringent::plate::Plate;
@@ -254,7 +255,7 @@ fn micro() -> Value {
                 C64::new(1.0, 0.0),
                 layer,
                 C64::new(1.5, 0.0),
-                rng.log_range(500.0, 5e6),
+                Thickness::from_nm(rng.log_range(500.0, 5e6)).unwrap(),
             )
             .unwrap();
             let frame = PlaneFrame::from_azimuth(rng.range(0.0, std::f64::consts::TAU));

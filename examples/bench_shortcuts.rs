@@ -42,6 +42,7 @@ use birefringent::material::Material;
 use birefringent::optics::frame::PlaneFrame;
 use birefringent::optics::medium::Uniaxial;
 use birefringent::optics::surface::Surface;
+use birefringent::params::Thickness;
 use birefringent::plate::slab::Output;
 use birefringent::plate::slab::Want;
 use birefringent::plate::Plate;
@@ -148,7 +149,7 @@ fn query(
         C64::new(1.0, 0.0),
         C64::new(1.0, 0.0),
         Vector3::from(axis),
-        thickness_um * 1e3,
+        Thickness::from_nm(thickness_um * 1e3).unwrap(),
         want.reflection,
         want.transmission,
         intensity,

@@ -19,6 +19,7 @@ use birefringent::material::Material;
 use birefringent::optics::interface::Interface;
 use birefringent::optics::medium::Uniaxial;
 use birefringent::optics::surface::Surface;
+use birefringent::params::Thickness;
 use birefringent::render::crystal::crystal_lobes;
 use birefringent::render::plate::{plate_lobes, PlateQuery, Spectrum};
 use birefringent::render::Transport;
@@ -158,9 +159,19 @@ fn main() {
             } else {
                 (1.0, Vector3::new(1.0, 1.0, 0.0))
             };
-            let q = PlateQuery::new(mat, 0.0, c(1.0), c(exit), axis, th, true, true, intensity)
-                .unwrap()
-                .with_absorbing_exit(scene);
+            let q = PlateQuery::new(
+                mat,
+                0.0,
+                c(1.0),
+                c(exit),
+                axis,
+                Thickness::from_nm(th).unwrap(),
+                true,
+                true,
+                intensity,
+            )
+            .unwrap()
+            .with_absorbing_exit(scene);
             for i in 0..n {
                 black_box(plate_lobes(&q, &spec, ds[i % 64], Transport::Radiance).unwrap());
             }

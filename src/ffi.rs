@@ -6,9 +6,10 @@
 //! naming the parameter; a non-finite result is reported as `BFR_INTERNAL`, never returned.
 
 use crate::error::{Error, Result};
-use crate::material::{Material, RENDER_RANGE_NM};
+use crate::material::{check_kappa, Material, RENDER_RANGE_NM};
 use crate::optics::medium::Uniaxial;
 use crate::optics::surface::Surface;
+use crate::params::{Length, Thickness};
 use crate::render::crystal::crystal_lobes;
 use crate::render::plate::{plate_lobes, PlateQuery, Spectrum, MAX_BANDS};
 use crate::render::{PathLobe, Transport};
@@ -152,14 +153,8 @@ fn null(name: &str) -> Error {
 
 fn material_from(desc: &BfrMaterialDesc) -> Result<Material> {
     if desc.material.is_null() {
-        for (name, k) in [("kappa_o", desc.kappa_o), ("kappa_e", desc.kappa_e)] {
-            if !(k.is_finite() && k >= 0.0) {
-                return Err(Error::new(
-                    name,
-                    format!("must be finite and >= 0, got {k}"),
-                ));
-            }
-        }
+        check_kappa("kappa_o", desc.kappa_o)?;
+        check_kappa("kappa_e", desc.kappa_e)?;
         let eo = c64(desc.eta_o) + C64::new(0.0, desc.kappa_o);
         let ee = c64(desc.eta_e) + C64::new(0.0, desc.kappa_e);
         return Material::constant(eo, ee);
@@ -335,7 +330,7 @@ fn plate_query(m: &Material, g: &BfrGeometry, flags: i32) -> Result<PlateQuery> 
         C64::new(g.ext_ior, 0.0),
         C64::new(g.exit_ior, 0.0),
         Vector3::from(g.optic_axis),
-        g.thickness_nm,
+        Thickness::new("thickness", g.thickness_nm, Length::Micrometres)?,
         flags & BFR_WANT_REFLECTION != 0,
         flags & BFR_WANT_TRANSMISSION != 0,
         flags & BFR_INTENSITY_ONLY != 0,

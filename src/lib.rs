@@ -12,6 +12,7 @@ pub mod error;
 pub mod ffi;
 pub mod material;
 pub mod optics;
+pub mod params;
 pub mod plate;
 pub mod render;
 pub mod spectral;

@@ -6,6 +6,7 @@ use birefringent::ffi::{BfrComplex, BfrGeometry, BfrMaterialDesc, BfrPathLobe};
 use birefringent::material::Material;
 use birefringent::optics::medium::Uniaxial;
 use birefringent::optics::surface::Surface;
+use birefringent::params::Thickness;
 use birefringent::render::crystal::crystal_lobes;
 use birefringent::render::plate::{plate_lobes, PlateQuery, Spectrum};
 use birefringent::render::Transport;
@@ -128,7 +129,7 @@ fn c_program_agrees_with_the_rust_api() {
         C64::new(1.0, 0.0),
         C64::new(1.0, 0.0),
         axis,
-        2500.0,
+        Thickness::from_nm(2500.0).unwrap(),
         true,
         true,
         false,
@@ -147,7 +148,7 @@ fn c_program_agrees_with_the_rust_api() {
         C64::new(1.0, 0.0),
         C64::new(1.0, 0.0),
         axis,
-        2500.0,
+        Thickness::from_nm(2500.0).unwrap(),
         false,
         true,
         true,

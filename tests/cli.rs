@@ -227,6 +227,19 @@ fn slab_errors_name_the_field() {
         ),
         (r#", "exit_ior": -1"#, "exit_ior"),
         (r#", "side": "inside""#, "side"),
+        // fields of the nested spectrum object keep its name (they were `bandwidth_nm`,
+        // `spectrum.input`)
+        (
+            r#", "spectrum": {"bandwidth_nm": "x"}"#,
+            "spectrum.bandwidth_nm",
+        ),
+        (r#", "spectrum": {"weights": 3}"#, "spectrum.weights"),
+        (r#", "spectrum": 3"#, "spectrum"),
+        // the quadrature's own step limit (it was the bare `step_nm`)
+        (
+            r#", "spectrum": {"bandwidth_nm": 100, "method": "quadrature", "step_nm": 1e-6}"#,
+            "spectrum.step_nm",
+        ),
     ];
     for (extra, field) in cases {
         let (code, v) = slab(extra);
@@ -252,4 +265,58 @@ fn an_evanescent_incident_wave_is_refused() {
     let v: Value = serde_json::from_str(&out).unwrap();
     let e = v["error"].as_str().unwrap();
     assert!(e.starts_with("incidence:") && e.contains("no power"), "{e}");
+}
+
+/// Every message names the field the user wrote, in the field's unit: a plate thicker than 1 m
+/// is `thickness_um` in µm (it was the core's `thickness` in nm), a band wider than a quarter
+/// of the wavelength is `spectrum.bandwidth_nm` with the limit at this wavelength.
+#[test]
+fn slab_range_errors_name_the_field_in_its_unit() {
+    let cases = [
+        (
+            r#""thickness_um": 2e6"#,
+            "thickness_um: must be within [0, 1e6] µm (1 m), got 2000000 µm",
+        ),
+        (
+            r#""thickness_um": -2"#,
+            "thickness_um: must be within [0, 1e6] µm (1 m), got -2 µm",
+        ),
+        (
+            r#""thickness_um": 12, "spectrum": {"bandwidth_nm": 150}"#,
+            "spectrum.bandwidth_nm: must be within [0, 137.5] nm (a quarter of the wavelength 550 nm), got 150 nm",
+        ),
+    ];
+    for (fields, want) in cases {
+        let input = format!(
+            r#"{{"wavelength_nm": 550, "eta_o": 1.5, "eta_e": 1.6, "optic_axis": [1,0,0], "theta_deg": 0, {fields}}}"#
+        );
+        let (code, out) = run(&["slab"], &input);
+        assert_eq!(code, 1, "{fields}");
+        let v: Value = serde_json::from_str(&out).unwrap();
+        assert_eq!(v["error"].as_str().unwrap(), want, "{fields}");
+    }
+}
+
+/// An extinction coefficient beyond the accepted range is named as written (`kappa_o`,
+/// `kappa_e`), for a named crystal and for constant indices (it was the core's `eta_e` /
+/// `eta_o`, the index it is added to).
+#[test]
+fn kappa_errors_name_the_kappa() {
+    for (fields, want) in [
+        (
+            r#""material": "quartz", "kappa_e": 2e3"#,
+            "kappa_e: must be within [0, 1000], got 2000",
+        ),
+        (
+            r#""eta_o": 1.5, "eta_e": 1.6, "kappa_o": 1e4"#,
+            "kappa_o: must be within [0, 1000], got 10000",
+        ),
+    ] {
+        let input =
+            format!(r#"{{"wavelength_nm": 550, "optic_axis": [1,0,0], "theta_deg": 0, {fields}}}"#);
+        let (code, out) = run(&["interface"], &input);
+        assert_eq!(code, 1, "{fields}");
+        let v: Value = serde_json::from_str(&out).unwrap();
+        assert_eq!(v["error"].as_str().unwrap(), want, "{fields}");
+    }
 }

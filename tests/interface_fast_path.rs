@@ -23,6 +23,7 @@ use birefringent::optics::frame::PlaneFrame;
 use birefringent::optics::interface::Interface;
 use birefringent::optics::medium::Uniaxial;
 use birefringent::optics::modes::modes;
+use birefringent::params::Thickness;
 use birefringent::plate::slab::Slab;
 use birefringent::C64;
 use nalgebra::{Matrix4, Vector3};
@@ -268,7 +269,7 @@ fn slab_interfaces_equal_the_4x4_solve() {
             C64::new(rng.range(1.0, 1.8), 0.0),
             layer,
             C64::new(rng.range(1.0, 1.8), 0.0),
-            1e4,
+            Thickness::from_nm(1e4).unwrap(),
         )
         .unwrap();
         let frame = PlaneFrame::from_azimuth(rng.range(0.0, std::f64::consts::TAU));

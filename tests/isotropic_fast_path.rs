@@ -8,6 +8,7 @@ use birefringent::optics::frame::PlaneFrame;
 use birefringent::optics::interface::Interface;
 use birefringent::optics::medium::Uniaxial;
 use birefringent::optics::modes::modes;
+use birefringent::params::Thickness;
 use birefringent::plate::etalon::Etalon;
 use birefringent::plate::slab::Output;
 use birefringent::plate::slab::Want;
@@ -284,7 +285,7 @@ fn isotropic_plate_lobes_shared_equal_per_lobe_solutions() {
             re(rng.range(1.0, 1.8)),
             re(rng.range(1.0, 1.8)),
             rng.unit_vector(),
-            10f64.powf(rng.range(1.0, 6.5)),
+            Thickness::from_nm(10f64.powf(rng.range(1.0, 6.5))).unwrap(),
             true,
             true,
             rng.chance(0.3),
@@ -351,7 +352,7 @@ fn several_wavelengths_in_one_query_equal_single_queries() {
             re(1.0),
             re(rng.range(1.0, 1.6)),
             rng.unit_vector(),
-            10f64.powf(rng.range(1.0, 6.5)),
+            Thickness::from_nm(10f64.powf(rng.range(1.0, 6.5))).unwrap(),
             true,
             true,
             false,
@@ -414,7 +415,7 @@ fn isotropic_plate_refuses_invalid_wavelengths() {
         re(1.0),
         re(1.0),
         Vector3::z(),
-        1e3,
+        Thickness::from_nm(1e3).unwrap(),
         true,
         true,
         false,

@@ -19,6 +19,7 @@ use birefringent::optics::frame::PlaneFrame;
 use birefringent::optics::medium::Uniaxial;
 use birefringent::optics::modes::ModeKind;
 use birefringent::optics::surface::{Incident, Surface};
+use birefringent::params::Thickness;
 use birefringent::plate::slab::{Slab, Want};
 use birefringent::render::crystal::crystal_lobes;
 use birefringent::render::Transport;
@@ -157,7 +158,7 @@ fn powers(j: &Matrix2<C64>) -> [[f64; 2]; 2] {
 
 /// A plate at one wavelength.
 fn slab(ext: f64, layer: Uniaxial, exit: f64, d_nm: f64) -> Slab {
-    Slab::new(re(ext), layer, re(exit), d_nm).unwrap()
+    Slab::new(re(ext), layer, re(exit), Thickness::from_nm(d_nm).unwrap()).unwrap()
 }
 
 /// Tolerance of plate comparisons that go through different rounding (a rotated axis, a
@@ -178,7 +179,7 @@ fn flipped(s: &Slab) -> Slab {
         s.bottom.eta_o,
         s.layer.with_axis(a),
         s.top.eta_o,
-        s.thickness_nm,
+        Thickness::from_nm(s.thickness_nm).unwrap(),
     )
     .unwrap()
 }

@@ -4,6 +4,7 @@
 
 use birefringent::optics::medium::Uniaxial;
 use birefringent::optics::surface::Surface;
+use birefringent::params::Thickness;
 use birefringent::render::crystal::crystal_lobes;
 use birefringent::render::Transport;
 use birefringent::C64;
@@ -93,7 +94,7 @@ fn intensity_only_plate_queries_return_m00_alone() {
                 C64::new(1.0, 0.0),
                 C64::new(1.2, 0.0),
                 Vector3::new(1.0, 0.5, 0.3),
-                20_000.0,
+                Thickness::from_nm(20_000.0).unwrap(),
                 true,
                 true,
                 intensity,
@@ -133,7 +134,7 @@ fn absorbing_exit_keeps_the_front_reflection_only() {
         C64::new(1.0, 0.0),
         C64::new(1.458, 0.0),
         Vector3::new(1.0, 1.0, 0.0),
-        700.0,
+        Thickness::from_nm(700.0).unwrap(),
         true,
         true,
         false,
@@ -186,7 +187,7 @@ fn srgb_lobes_keep_negative_channels() {
         C64::new(1.0, 0.0),
         C64::new(1.458, 0.0),
         Vector3::new(1.0, 0.0, 0.0),
-        285.0,
+        Thickness::from_nm(285.0).unwrap(),
         true,
         true,
         true,
@@ -329,7 +330,7 @@ fn vanishing_bandwidth_is_exact() {
         C64::new(1.0, 0.0),
         C64::new(1.5, 0.0),
         Vector3::new(1.0, 0.5, 0.3),
-        20_000.0,
+        Thickness::from_nm(20_000.0).unwrap(),
         true,
         true,
         false,

@@ -4,6 +4,7 @@
 
 use birefringent::optics::frame::PlaneFrame;
 use birefringent::optics::medium::Uniaxial;
+use birefringent::params::Thickness;
 use birefringent::plate::paths::PathExpansion;
 use birefringent::plate::slab::{Slab, Want};
 use birefringent::C64;
@@ -42,7 +43,13 @@ fn isotropic_layer_is_the_airy_etalon() {
             for d in [10.0, 333.0, 2500.0, 1e5] {
                 for deg in [0.0, 20.0, 45.0, 70.0, 85.0] {
                     let beta = n1.re * f64::to_radians(deg).sin();
-                    let slab = Slab::new(n1, Uniaxial::isotropic(n2).unwrap(), n3, d).unwrap();
+                    let slab = Slab::new(
+                        n1,
+                        Uniaxial::isotropic(n2).unwrap(),
+                        n3,
+                        Thickness::from_nm(d).unwrap(),
+                    )
+                    .unwrap();
                     let optics = slab
                         .optics(&PlaneFrame::from_azimuth(0.4), re(beta))
                         .unwrap();
@@ -97,7 +104,7 @@ fn lossless_slabs_conserve_energy() {
         .unwrap();
         let (n1, n3) = (rng.range(1.0, 1.6), rng.range(1.0, 1.6));
         let d = 10f64.powf(rng.range(1.0, 6.7));
-        let slab = Slab::new(re(n1), layer, re(n3), d).unwrap();
+        let slab = Slab::new(re(n1), layer, re(n3), Thickness::from_nm(d).unwrap()).unwrap();
         let beta = n1 * rng.range(0.0, 85f64.to_radians()).sin();
         let optics = slab
             .optics(&PlaneFrame::from_azimuth(rng.range(0.0, 6.3)), re(beta))
@@ -124,7 +131,7 @@ fn normal_incidence_direct_path_is_a_linear_retarder_with_fresnel_factors() {
             re(1.0),
             Uniaxial::new(re(no), re(ne), axis).unwrap(),
             re(1.0),
-            d,
+            Thickness::from_nm(d).unwrap(),
         )
         .unwrap();
         let frame = PlaneFrame::from_azimuth(0.0);
@@ -171,7 +178,13 @@ fn thick_isotropic_plate_incoherent_limit_is_the_thindielectric_series() {
     let d = 2e6; // 2 mm
     for deg in [0.0, 30.0, 60.0] {
         let beta = f64::to_radians(deg).sin();
-        let slab = Slab::new(re(1.0), Uniaxial::isotropic(re(n)).unwrap(), re(1.0), d).unwrap();
+        let slab = Slab::new(
+            re(1.0),
+            Uniaxial::isotropic(re(n)).unwrap(),
+            re(1.0),
+            Thickness::from_nm(d).unwrap(),
+        )
+        .unwrap();
         let optics = slab
             .optics(&PlaneFrame::from_azimuth(0.0), re(beta))
             .unwrap();
@@ -246,7 +259,7 @@ fn path_expansion_to_high_order_equals_the_exact_slab() {
             re(1.0),
             layer,
             re(rng.range(1.0, 1.6)),
-            rng.range(50.0, 5000.0),
+            Thickness::from_nm(rng.range(50.0, 5000.0)).unwrap(),
         )
         .unwrap();
         let beta = rng.range(0.0, 0.95);

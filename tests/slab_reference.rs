@@ -5,6 +5,7 @@
 
 use birefringent::optics::frame::PlaneFrame;
 use birefringent::optics::medium::Uniaxial;
+use birefringent::params::Thickness;
 use birefringent::plate::slab::{Slab, Want};
 use birefringent::C64;
 
@@ -33,7 +34,13 @@ fn exact_slab_matches_the_berreman_plate_over_random_plates() {
             rng.range(1.0, 1.8)
         };
         let d = 10f64.powf(rng.range(1.0, 6.7)); // 10 nm .. 5 mm
-        let slab = Slab::new(C64::new(n1, 0.0), layer, C64::new(n3, 0.0), d).unwrap();
+        let slab = Slab::new(
+            C64::new(n1, 0.0),
+            layer,
+            C64::new(n3, 0.0),
+            Thickness::from_nm(d).unwrap(),
+        )
+        .unwrap();
         let theta = rng.range(0.0, 85f64.to_radians());
         let beta = C64::new(n1 * theta.sin(), 0.0);
         let frame = PlaneFrame::from_azimuth(rng.range(0.0, 6.3));

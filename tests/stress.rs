@@ -722,12 +722,17 @@ fn c_abi_with_f32_inputs_as_the_shim_passes_them() {
                 .to_string_lossy()
                 .into_owned();
             // An absorbing birefringent crystal is refused as a bulk surface (its per-ray powers
-            // are undefined): a clear error naming kappa, never lobes.
+            // are undefined): a clear error naming the kappa that is given, never lobes.
             let isotropic =
                 !named && desc.eta_o.re == desc.eta_e.re && desc.kappa_o == desc.kappa_e;
             if !lossless && !isotropic && (desc.kappa_o > 0.0 || desc.kappa_e > 0.0) {
                 assert_eq!(rc, BFR_INVALID, "absorbing crystal accepted: {desc:?}");
-                assert!(text.starts_with("kappa:"), "{text}");
+                let named = if desc.kappa_o > 0.0 {
+                    "kappa_o:"
+                } else {
+                    "kappa_e:"
+                };
+                assert!(text.starts_with(named), "{text}");
                 refused += 1;
             } else {
                 assert_eq!(

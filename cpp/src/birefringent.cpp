@@ -85,6 +85,7 @@ double refraction needs a polarized variant; an isotropic material (``eta_o == e
         'optic_axis_space': 'world'
 */
 #include "common.h"
+#include "last_valid.h"
 
 NAMESPACE_BEGIN(mitsuba)
 
@@ -111,7 +112,7 @@ public:
     }
 
     void traverse(TraversalCallback *cb) override {
-        if (m_params.material.empty()) {
+        if (!m_params.named) {
             cb->put("eta_o", m_params.eta_o, ParamFlags::NonDifferentiable);
             cb->put("eta_e", m_params.eta_e, ParamFlags::NonDifferentiable);
         }
@@ -121,8 +122,15 @@ public:
         cb->put("optic_axis", m_optic_axis, ParamFlags::NonDifferentiable);
     }
 
-    /// Rebuilds the core material and the flags, and checks every parameter with one core query.
+    /// Applies changed parameters; a rejected update leaves the last valid state in force
+    /// (bfr::update_or_restore).
     void parameters_changed(const std::vector<std::string> & /*keys*/ = {}) override {
+        bfr::update_or_restore<Float, Spectrum>(this, m_valid, [this] { rebuild(); });
+    }
+
+private:
+    /// Rebuilds the core material and the flags, and checks every parameter with one core query.
+    void rebuild() {
         if (!is_polarized_v<Spectrum> && !m_params.isotropic())
             Throw("double refraction (eta_o != eta_e, or a named crystal: %s) needs a polarized "
                   "variant, which carries whether a ray in the crystal is ordinary or "
@@ -135,8 +143,15 @@ public:
         m_types[0] = BSDFFlags::DeltaReflection;
         m_types[1] = m_types[2] = BSDFFlags::DeltaTransmission;
         m_components.clear();
-        for (BSDFFlags t : m_types)
-            m_components.push_back((uint32_t) t | sides);
+        // A lobe between different ray indices (a refraction; inside a birefringent crystal
+        // also a reflection that converts o into e) carries the radiance factor
+        // (n_wi / n_wo)^2 in its Radiance weight and not in its Importance weight:
+        // non-symmetric, as Mitsuba's `dielectric` declares its refraction.
+        for (size_t k = 0; k < 3; ++k) {
+            bool asym = k > 0 || !m_params.isotropic();
+            m_components.push_back((uint32_t) m_types[k] | sides |
+                                   (asym ? (uint32_t) BSDFFlags::NonSymmetric : 0u));
+        }
         m_flags = m_components[0] | m_components[1] | m_components[2];
 
         bfr_geometry g = geometry(m_optic_axis);
@@ -149,6 +164,7 @@ public:
             Throw("%s", bfr::core_error(rc, message));
     }
 
+public:
     std::pair<BSDFSample3f, Spectrum> sample(const BSDFContext &ctx, const SurfaceInteraction3f &si,
                                              Float sample1, const Point2f & /*sample2*/,
                                              Mask active) const override {
@@ -228,6 +244,7 @@ private:
     bool m_axis_in_world = false;
     BSDFFlags m_types[3];
     mutable std::atomic<bool> m_warned { false };
+    std::unique_ptr<bfr::Snapshot<Float, Spectrum>> m_valid;  ///< last valid state
 
     MI_TRAVERSE_CB(Base)
 };

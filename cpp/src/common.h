@@ -43,18 +43,19 @@ using MaterialPtr = std::shared_ptr<const bfr_material>;
 
 /// The material parameters as given in the scene description.
 struct MaterialParams {
-    std::string material;  ///< named crystal, or empty for constant indices
+    bool named = true;     ///< a named crystal (`material`), else constant indices
+    std::string material;  ///< the crystal's name as given (the core refuses an unknown one)
     double eta_o = 0, eta_e = 0, kappa_o = 0, kappa_e = 0;
 
     /// Constant, equal principal indices: the medium is isotropic (the core then returns the
     /// refracted light as one s/p lobe, component 1).
     bool isotropic() const {
-        return material.empty() && eta_o == eta_e && kappa_o == kappa_e;
+        return !named && eta_o == eta_e && kappa_o == kappa_e;
     }
 
     std::string to_string() const {
         std::ostringstream oss;
-        if (!material.empty())
+        if (named)
             oss << "material = \"" << material << "\", ";
         else
             oss << "eta_o = " << eta_o << ", eta_e = " << eta_e << ", ";
@@ -84,6 +85,7 @@ inline MaterialParams parse_material(const Properties &props, const char *ClassN
         Throw("\"%s\" is missing (\"%s\" is given): give both eta_o and eta_e, or \"material\"",
               has_o ? "eta_e" : "eta_o", has_o ? "eta_o" : "eta_e");
     if (has_o) {
+        m.named = false;
         m.eta_o = props.get<double>("eta_o");
         m.eta_e = props.get<double>("eta_e");
     } else {
@@ -97,7 +99,7 @@ inline MaterialParams parse_material(const Properties &props, const char *ClassN
 /// Builds the core's material; throws the core's message (it names the parameter).
 inline MaterialPtr make_material(const MaterialParams &p, const char *ClassName) {
     bfr_material_desc desc{};
-    desc.material = p.material.empty() ? nullptr : p.material.c_str();
+    desc.material = p.named ? p.material.c_str() : nullptr;
     desc.eta_o = { p.eta_o, 0.0 };
     desc.eta_e = { p.eta_e, 0.0 };
     desc.kappa_o = p.kappa_o;
@@ -118,6 +120,9 @@ inline double parse_ior(const Properties &props, const std::string &name,
         auto type = props.type(name);
         if (type == Properties::Type::Float || type == Properties::Type::Integer)
             return props.get<double>(name);
+        if (type != Properties::Type::String)
+            Throw("\"%s\" must be a float (a real index) or one of Mitsuba's IOR names (e.g. "
+                  "\"water\"), got %s", name, property_type_name(type));
     }
     try {
         return (double) lookup_ior(props, name, default_name);

@@ -128,6 +128,9 @@ evaluated with ``eval_1`` at the hit point (use ``raw="true"`` for data bitmaps)
         'thickness': 30.0
 */
 #include "common.h"
+#include "last_valid.h"
+#include "scalar_texture.h"
+#include "signed_rgb.h"
 
 NAMESPACE_BEGIN(mitsuba)
 
@@ -148,20 +151,23 @@ public:
                          ? bfr::parse_ior(props, "exit_ior", "air", ClassName)
                          : m_ext_ior;
         m_optic_axis = props.get<ScalarVector3f>("optic_axis", ScalarVector3f(1.f, 0.f, 0.f));
-        m_thickness = props.get_unbounded_texture<Texture>("thickness", 1.f);
+        m_thickness = bfr::scalar_texture<Float, Spectrum>(props, "thickness", 1.0,
+                                                           "micrometres", ClassName);
         m_thickness_scale = props.get<double>("thickness_scale", 1.0);
         if (props.has_property("birefringence"))
-            m_birefringence = props.get_unbounded_texture<Texture>("birefringence", 0.f);
+            m_birefringence = bfr::scalar_texture<Float, Spectrum>(
+                props, "birefringence", 0.0, "added to eta_e", ClassName);
         m_birefringence_scale = props.get<double>("birefringence_scale", 1.0);
         if (props.has_property("axis_angle"))
-            m_axis_angle = props.get_unbounded_texture<Texture>("axis_angle", 0.f);
+            m_axis_angle = bfr::scalar_texture<Float, Spectrum>(props, "axis_angle", 0.0,
+                                                                "degrees", ClassName);
         m_filter_bandwidth = props.get<double>("filter_bandwidth", DefaultFilterBandwidth);
         m_absorbing_exit = props.get<bool>("absorbing_exit", false);
         parameters_changed();
     }
 
     void traverse(TraversalCallback *cb) override {
-        if (m_params.material.empty()) {
+        if (!m_params.named) {
             cb->put("eta_o", m_params.eta_o, ParamFlags::NonDifferentiable);
             cb->put("eta_e", m_params.eta_e, ParamFlags::NonDifferentiable);
         }
@@ -180,9 +186,16 @@ public:
         cb->put("filter_bandwidth", m_filter_bandwidth, ParamFlags::NonDifferentiable);
     }
 
+    /// Applies changed parameters; a rejected update leaves the last valid state in force
+    /// (bfr::update_or_restore).
+    void parameters_changed(const std::vector<std::string> & /*keys*/ = {}) override {
+        bfr::update_or_restore<Float, Spectrum>(this, m_valid, [this] { rebuild(); });
+    }
+
+private:
     /// Rebuilds the core material and the flags, and checks every parameter with one core query
     /// (textures at their mean), so that invalid input fails here, with the core's message.
-    void parameters_changed(const std::vector<std::string> & /*keys*/ = {}) override {
+    void rebuild() {
         m_material = bfr::make_material(m_params, ClassName);
         m_null = m_exit_ior == m_ext_ior && !m_absorbing_exit;
         uint32_t aniso = (m_params.isotropic() && !m_birefringence) ? 0u : (uint32_t) BSDFFlags::Anisotropic;
@@ -194,13 +207,19 @@ public:
             m_components.push_back((uint32_t) m_types[0] | (uint32_t) BSDFFlags::FrontSide | aniso);
             m_flags = m_components[0];
         } else {
+            // Between different indices the transmission's Radiance weight carries the radiance
+            // factor (n_wi / n_wo)^2 and its Importance weight does not (see birefringent.cpp).
+            uint32_t asym = m_exit_ior != m_ext_ior ? (uint32_t) BSDFFlags::NonSymmetric : 0u;
             m_components.push_back((uint32_t) m_types[0] | sides);
-            m_components.push_back((uint32_t) m_types[1] | sides);
+            m_components.push_back((uint32_t) m_types[1] | sides | asym);
             m_flags = m_components[0] | m_components[1];
         }
 
-        bfr_geometry g = geometry(m_thickness->mean(), m_birefringence ? m_birefringence->mean() : 0.0,
-                                  m_axis_angle ? m_axis_angle->mean() : 0.0);
+        bfr_geometry g;
+        std::string error;
+        if (!geometry(m_thickness->mean(), m_birefringence ? m_birefringence->mean() : 0.0,
+                      m_axis_angle ? m_axis_angle->mean() : 0.0, g, error))
+            Throw("%s", error);
         const double wi[3] = { 0.0, 0.0, 1.0 };
         bfr_path_lobe out[2];
         char message[bfr::MessageLen] = { 0 };
@@ -211,6 +230,7 @@ public:
             Throw("%s", bfr::core_error(rc, message));
     }
 
+public:
     std::pair<BSDFSample3f, Spectrum> sample(const BSDFContext &ctx, const SurfaceInteraction3f &si,
                                              Float sample1, const Point2f & /*sample2*/,
                                              Mask active) const override {
@@ -269,25 +289,39 @@ public:
 
 private:
     /// Geometry from the texture values: thickness (um, before scaling), birefringence (before
-    /// scaling), axis angle (degrees).
-    bfr_geometry geometry(double thickness_um, double birefringence, double angle_deg) const {
-        bfr_geometry g{};
+    /// scaling), axis angle (degrees). False, with the message in `error`, if the angle is not
+    /// a finite number: the core sees only the rotated axis and would name `optic_axis`.
+    bool geometry(double thickness_um, double birefringence, double angle_deg, bfr_geometry &g,
+                  std::string &error) const {
+        if (!std::isfinite(angle_deg)) {
+            error = "axis_angle: must be a finite number (degrees), got " + std::to_string(angle_deg);
+            return false;
+        }
+        g = bfr_geometry{};
         g.ext_ior = m_ext_ior;
         g.exit_ior = m_exit_ior;
         const double axis[3] = { m_optic_axis.x(), m_optic_axis.y(), m_optic_axis.z() };
         bfr::rotate_about_normal(axis, angle_deg, g.optic_axis);
         g.thickness_nm = 1000.0 * m_thickness_scale * thickness_um;
         g.birefringence = m_birefringence_scale * birefringence;
-        return g;
+        return true;
     }
 
     /// Core query at si: lobes[ch * 2 + i] for channel ch, lobe i (0 R, 1 T). False (after one
     /// warning) if the core refuses, e.g. a texture gives a negative thickness.
     bool query(const SurfaceInteraction3f &si, TransportMode mode, int32_t want,
                bfr_path_lobe *lobes) const {
-        bfr_geometry g = geometry(m_thickness->eval_1(si),
-                                  m_birefringence ? (double) m_birefringence->eval_1(si) : 0.0,
-                                  m_axis_angle ? (double) m_axis_angle->eval_1(si) : 0.0);
+        auto refuse = [this](const std::string &error) {
+            if (!m_warned.exchange(true))
+                Log(Warn, "%s (returning no light; further errors are not reported)", error);
+            return false;
+        };
+        bfr_geometry g;
+        std::string error;
+        if (!geometry(m_thickness->eval_1(si),
+                      m_birefringence ? (double) m_birefringence->eval_1(si) : 0.0,
+                      m_axis_angle ? (double) m_axis_angle->eval_1(si) : 0.0, g, error))
+            return refuse(error);
         const double wi[3] = { si.wi.x(), si.wi.y(), si.wi.z() };
         int32_t transport = mode == TransportMode::Radiance ? BFR_RADIANCE : BFR_IMPORTANCE;
         int32_t flags = want | (is_polarized_v<Spectrum> ? 0 : BFR_INTENSITY_ONLY) |
@@ -310,12 +344,8 @@ private:
                                    m_filter_bandwidth, wi, transport, flags, lobes, message,
                                    sizeof(message));
         }
-        if (rc != BFR_OK) {
-            if (!m_warned.exchange(true))
-                Log(Warn, "%s (returning no light; further errors are not reported)",
-                    bfr::core_error(rc, message));
-            return false;
-        }
+        if (rc != BFR_OK)
+            return refuse(bfr::core_error(rc, message));
         return true;
     }
 
@@ -328,6 +358,8 @@ private:
     bool m_null = true, m_absorbing_exit = false;
     BSDFFlags m_types[2];
     mutable std::atomic<bool> m_warned { false };
+    bfr::SignedRgbGuard m_signed_rgb { is_rgb_v<Spectrum> };  ///< see signed_rgb.h
+    std::unique_ptr<bfr::Snapshot<Float, Spectrum>> m_valid;  ///< last valid state
 
     MI_TRAVERSE_CB(Base, m_thickness, m_birefringence, m_axis_angle)
 };

@@ -6,17 +6,27 @@ use num_complex::Complex64 as C64;
 use serde_json::{Map, Value};
 
 /// A JSON object read field by field. Unknown (e.g. misspelt) fields are rejected up front,
-/// before anything else is reported, since they are usually the root cause.
+/// before anything else is reported, since they are usually the root cause. Errors name the
+/// field as the user wrote it: `spectrum.bandwidth_nm` for a field of the nested `spectrum`.
 pub struct Fields<'a> {
     map: &'a Map<String, Value>,
+    /// The object's own name (`"spectrum"`), or empty for the input itself.
+    prefix: &'static str,
 }
 
 impl<'a> Fields<'a> {
     /// Wraps a JSON value that must be an object with only `accepted` fields.
     pub fn new(value: &'a Value, accepted: &[&str]) -> Result<Self> {
+        Fields::nested(value, accepted, "")
+    }
+
+    /// [`Fields::new`] for the object in field `prefix` of the input (empty: the input).
+    pub fn nested(value: &'a Value, accepted: &[&str], prefix: &'static str) -> Result<Self> {
         let Value::Object(map) = value else {
-            return Err(Error::new("input", "must be a JSON object"));
+            let what = if prefix.is_empty() { "input" } else { prefix };
+            return Err(Error::new(what, "must be a JSON object"));
         };
+        let fields = Fields { map, prefix };
         let mut unknown: Vec<&String> = map
             .keys()
             .filter(|k| !accepted.contains(&k.as_str()))
@@ -24,11 +34,20 @@ impl<'a> Fields<'a> {
         unknown.sort();
         if let Some(k) = unknown.first() {
             return Err(Error::new(
-                k.as_str(),
+                fields.qualified(k),
                 format!("unknown field (accepted: {})", accepted.join(", ")),
             ));
         }
-        Ok(Fields { map })
+        Ok(fields)
+    }
+
+    /// The name of field `name` as the user wrote it.
+    pub fn qualified(&self, name: &str) -> String {
+        if self.prefix.is_empty() {
+            name.to_string()
+        } else {
+            format!("{}.{name}", self.prefix)
+        }
     }
 
     /// The raw value of `name`, if present (and not null).
@@ -43,33 +62,37 @@ impl<'a> Fields<'a> {
 
     /// An optional finite number.
     pub fn number(&mut self, name: &'static str) -> Result<Option<f64>> {
-        self.get(name).map(|v| number(name, v)).transpose()
+        let full = self.qualified(name);
+        self.get(name).map(|v| number(&full, v)).transpose()
     }
 
     /// A required finite number.
     pub fn required_number(&mut self, name: &'static str) -> Result<f64> {
         self.number(name)?
-            .ok_or_else(|| Error::new(name, "is required"))
+            .ok_or_else(|| Error::new(self.qualified(name), "is required"))
     }
 
     /// An optional complex number: a number or `[re, im]`.
     pub fn complex(&mut self, name: &'static str) -> Result<Option<C64>> {
-        self.get(name).map(|v| complex(name, v)).transpose()
+        let full = self.qualified(name);
+        self.get(name).map(|v| complex(&full, v)).transpose()
     }
 
     /// An optional string.
     pub fn string(&mut self, name: &'static str) -> Result<Option<&'a str>> {
+        let full = self.qualified(name);
         self.get(name)
             .map(|v| {
                 v.as_str()
-                    .ok_or_else(|| Error::new(name, "must be a string"))
+                    .ok_or_else(|| Error::new(full, "must be a string"))
             })
             .transpose()
     }
 
     /// An optional 3-vector `[x, y, z]`.
     pub fn vector3(&mut self, name: &'static str) -> Result<Option<Vector3<f64>>> {
-        self.get(name).map(|v| vector3(name, v)).transpose()
+        let full = self.qualified(name);
+        self.get(name).map(|v| vector3(&full, v)).transpose()
     }
 }
 

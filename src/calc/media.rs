@@ -3,7 +3,7 @@
 use super::input::Fields;
 use crate::error::{Error, Result};
 use crate::material::crystals;
-use crate::material::Material;
+use crate::material::{check_kappa, Material};
 use crate::optics::medium::Uniaxial;
 use nalgebra::Vector3;
 use num_complex::Complex64 as C64;
@@ -100,7 +100,7 @@ fn read_material(f: &mut Fields) -> Result<Material> {
                     name,
                     "the index already has an imaginary part; give one or the other",
                 )),
-                Some(k) => Ok(C64::new(eta.re, k)),
+                Some(k) => Ok(C64::new(eta.re, check_kappa(name, k)?)),
                 None => Ok(eta),
             };
             Material::constant(add("kappa_o", o, ko)?, add("kappa_e", e, ke)?)

@@ -4,8 +4,9 @@ use super::input::Fields;
 use super::interface::read_incidence;
 use super::media;
 use super::output::{complex, num};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::optics::surface::Surface;
+use crate::params::{Length, Thickness};
 use crate::plate::slab::{Slab, Want};
 use crate::plate::Plate;
 use nalgebra::{Matrix2, Matrix4};
@@ -31,17 +32,15 @@ pub struct SlabQuery {
 /// Reads the slab fields (everything but `spectrum`).
 pub fn read(f: &mut Fields) -> Result<SlabQuery> {
     let m = media::read(f)?;
-    let thickness_um = f.required_number("thickness_um")?;
-    if thickness_um < 0.0 {
-        return Err(Error::new(
-            "thickness_um",
-            format!("must be >= 0, got {thickness_um}"),
-        ));
-    }
+    let thickness = Thickness::new(
+        "thickness_um",
+        f.required_number("thickness_um")? * 1e3,
+        Length::Micrometres,
+    )?;
     let exit = media::read_ior(f, "exit_ior")?.unwrap_or(m.ext);
     let surface = Surface::new(m.ext, m.crystal)?;
     let inc = read_incidence(f, &surface, false)?;
-    let slab = Slab::new(m.ext, m.crystal, exit, thickness_um * 1e3)?;
+    let slab = Slab::new(m.ext, m.crystal, exit, thickness)?;
     Ok(SlabQuery {
         plate: Plate {
             material: m.material,

@@ -7,6 +7,7 @@ use super::output::num;
 use super::slab::{matrix, read, SlabQuery};
 use crate::band::{is_exact_band, narrow_band};
 use crate::error::{Error, Result};
+use crate::params::Bandwidth;
 use crate::plate::slab::Output;
 use crate::plate::slab::{SlabMueller, Want};
 use crate::spectral::integrate::{integrate, integrate_set, quadrature};
@@ -21,8 +22,11 @@ const RANGE: (f64, f64) = crate::material::RENDER_RANGE_NM;
 pub fn run(input: &Value, fields: &[&str], spec: &Value) -> Result<Value> {
     let mut f = Fields::new(input, fields)?;
     let q = read(&mut f)?;
-    let mut s = Fields::new(spec, &["weights", "method", "step_nm", "bandwidth_nm"])
-        .map_err(|e| Error::new(format!("spectrum.{}", e.parameter), e.message))?;
+    let mut s = Fields::nested(
+        spec,
+        &["weights", "method", "step_nm", "bandwidth_nm"],
+        "spectrum",
+    )?;
     let method = s.string("method")?.unwrap_or("analytic");
     if !matches!(method, "analytic" | "quadrature") {
         return Err(Error::new(
@@ -64,6 +68,7 @@ pub fn run(input: &Value, fields: &[&str], spec: &Value) -> Result<Value> {
                                 step,
                                 Want::BOTH,
                             )
+                            .map_err(step_field)
                         })
                         .collect::<Result<Vec<_>>>()?
                 } else {
@@ -76,13 +81,12 @@ pub fn run(input: &Value, fields: &[&str], spec: &Value) -> Result<Value> {
                 )
             }
             (None, Some(b)) => {
-                if !(0.0..=0.25 * q.wavelength_nm).contains(&b) {
-                    return Err(Error::new(
-                        "spectrum.bandwidth_nm",
-                        format!("must be within [0, wavelength_nm / 4], got {b}"),
-                    ));
-                }
-                let m = band(&q, b, quad, step)?;
+                let m = band(
+                    &q,
+                    Bandwidth::new("spectrum.bandwidth_nm", b, q.wavelength_nm)?,
+                    quad,
+                    step,
+                )?;
                 (
                     vec![format!("{} nm ± {b} nm FWHM", q.wavelength_nm)],
                     vec![m],
@@ -142,7 +146,8 @@ fn power(m: &Matrix4<f64>, input: f64, output: f64) -> f64 {
 }
 
 /// A Gaussian band of FWHM `b` around the query's wavelength.
-fn band(q: &SlabQuery, b: f64, quad: bool, step: Option<f64>) -> Result<SlabMueller> {
+fn band(q: &SlabQuery, b: Bandwidth, quad: bool, step: Option<f64>) -> Result<SlabMueller> {
+    let b = b.fwhm_nm();
     if is_exact_band(b, q.wavelength_nm) {
         return q
             .slab
@@ -176,6 +181,16 @@ fn band(q: &SlabQuery, b: f64, quad: bool, step: Option<f64>) -> Result<SlabMuel
         step.unwrap_or_else(|| auto_step(q, range.0)),
         Want::BOTH,
     )
+    .map_err(step_field)
+}
+
+/// The quadrature's error about its step under the name of the field that sets it.
+fn step_field(e: Error) -> Error {
+    if e.parameter == "step_nm" {
+        Error::new("spectrum.step_nm", e.message)
+    } else {
+        e
+    }
 }
 
 /// A quadrature step resolving the fringes of up to ~10 internal round trips at the shortest

@@ -102,11 +102,8 @@ impl Material {
                 ),
             )
         })?;
-        for (p, k) in [("kappa_o", kappa_o), ("kappa_e", kappa_e)] {
-            if !(k.is_finite() && k >= 0.0) {
-                return Err(Error::new(p, format!("must be finite and >= 0, got {k}")));
-            }
-        }
+        check_kappa("kappa_o", kappa_o)?;
+        check_kappa("kappa_e", kappa_e)?;
         let index = |extraordinary, kappa| Index::Crystal {
             crystal,
             extraordinary,
@@ -225,6 +222,19 @@ pub fn check_clear_index(parameter: &str, eta: C64) -> Result<C64> {
 pub const INDEX_RANGE: (f64, f64) = (1e-3, 1e3);
 /// Largest extinction coefficient `κ` (metals reach ~100 in the infrared).
 pub const KAPPA_MAX: f64 = 1e3;
+
+/// Validates an extinction coefficient given on its own (`kappa_o`, `kappa_e`): finite,
+/// `0 <= κ <=` [`KAPPA_MAX`], the range [`check_index`] allows for an index's imaginary part.
+pub fn check_kappa(parameter: &str, kappa: f64) -> Result<f64> {
+    if kappa.is_finite() && (0.0..=KAPPA_MAX).contains(&kappa) {
+        Ok(kappa)
+    } else {
+        Err(Error::new(
+            parameter,
+            format!("must be within [0, {KAPPA_MAX}], got {kappa}"),
+        ))
+    }
+}
 
 /// Validates one complex index `n + iκ`: finite, `n` within [`INDEX_RANGE`], `0 <= κ <=`
 /// [`KAPPA_MAX`].

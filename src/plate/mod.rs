@@ -17,6 +17,10 @@ use nalgebra::Vector3;
 use num_complex::Complex64 as C64;
 
 /// A uniaxial plate between isotropic media, with possibly dispersive principal indices.
+///
+/// Its parameters are validated where the plate is assembled from a caller's input
+/// ([`crate::render::plate::PlateQuery::new`], the calculator's reader): real exterior and exit
+/// indices, a unit optic axis, a [`crate::params::Thickness`]. [`Plate::at`] relies on that.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Plate {
     /// The plate's material.
@@ -34,15 +38,15 @@ pub struct Plate {
 }
 
 impl Plate {
-    /// The slab at `lambda_nm`.
+    /// The slab at `lambda_nm` (the plate's own parameters are not checked again).
     pub fn at(&self, lambda_nm: f64) -> Result<Slab> {
         let (eo, ee) = self.material.indices(lambda_nm, self.birefringence)?;
-        Slab::new(
-            self.ext,
-            Uniaxial::new(eo, ee, self.axis)?,
-            self.exit,
-            self.thickness_nm,
-        )
+        Ok(Slab {
+            top: Uniaxial::isotropic(self.ext)?,
+            layer: Uniaxial::new(eo, ee, self.axis)?,
+            bottom: Uniaxial::isotropic(self.exit)?,
+            thickness_nm: self.thickness_nm,
+        })
     }
 
     /// True if any index varies with wavelength.

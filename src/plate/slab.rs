@@ -22,12 +22,9 @@ use crate::optics::interface::Interface;
 use crate::optics::medium::Uniaxial;
 use crate::optics::modes::{modes, normal_components, ModeSet};
 use crate::optics::mueller;
+use crate::params::Thickness;
 use nalgebra::{Matrix2, Matrix4};
 use num_complex::Complex64 as C64;
-
-/// Largest plate thickness (nm): 1 m. Beyond, the phases `k d q` (~1e7 rad per metre at
-/// 550 nm) lose the digits that interference needs.
-pub const THICKNESS_MAX_NM: f64 = 1e9;
 
 /// A uniaxial plate between an isotropic top (light arrives from there) and bottom medium.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -93,19 +90,14 @@ pub struct SlabMueller {
 }
 
 impl Slab {
-    /// A validated slab.
-    pub fn new(top: C64, layer: Uniaxial, bottom: C64, thickness_nm: f64) -> Result<Self> {
-        if !((0.0..=THICKNESS_MAX_NM).contains(&thickness_nm)) {
-            return Err(Error::new(
-                "thickness",
-                format!("must be within [0, 1e9] nm (1 m), got {thickness_nm}"),
-            ));
-        }
+    /// A slab between the real indices `top` and `bottom` (checked, as `ext_ior` and
+    /// `exit_ior`), of a validated thickness.
+    pub fn new(top: C64, layer: Uniaxial, bottom: C64, thickness: Thickness) -> Result<Self> {
         Ok(Slab {
             top: Uniaxial::isotropic(check_clear_index("ext_ior", top)?)?,
             layer,
             bottom: Uniaxial::isotropic(check_clear_index("exit_ior", bottom)?)?,
-            thickness_nm,
+            thickness_nm: thickness.nm(),
         })
     }
 

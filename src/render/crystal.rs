@@ -62,7 +62,7 @@ fn outgoing(event: &Event, incident: Option<ModeKind>) -> Vec<(usize, Option<Mod
 
 /// Lobes of a bulk crystal surface seen from `wi` (unit, local; `wi.z < 0` is inside). A
 /// lossless isotropic crystal takes the closed form of [`crate::render::isotropic`]. Absorbing
-/// anisotropic crystals are refused (an error naming `kappa`): their per-ray powers are not
+/// anisotropic crystals are refused (an error naming `kappa_o` or `kappa_e`): their per-ray powers are not
 /// defined (see the error message); isotropic absorbing media (metals, lossy dielectrics) are
 /// opaque, with the reflection lobe alone (module documentation).
 pub fn crystal_lobes(
@@ -71,8 +71,13 @@ pub fn crystal_lobes(
     transport: Transport,
 ) -> Result<Vec<PathLobe>> {
     if !surface.crystal.is_isotropic() && !surface.crystal.is_lossless() {
+        let absorbing = if surface.crystal.eta_o.im != 0.0 {
+            "kappa_o"
+        } else {
+            "kappa_e"
+        };
         return Err(Error::new(
-            "kappa",
+            absorbing,
             "an absorbing birefringent crystal cannot be rendered as a bulk surface: inside it the o and e waves are not power-orthogonal (their fluxes do not add), so the power of each refracted ray is undefined and lobe weights would not conserve energy. Use thinbirefringent for a dichroic plate (its transmission is exact), or kappa_o = kappa_e = 0 here",
         ));
     }

@@ -9,7 +9,8 @@ use crate::material::check_clear_index;
 use crate::material::{check_wavelength, Material};
 use crate::optics::frame::PlaneFrame;
 use crate::optics::medium::Uniaxial;
-use crate::plate::slab::{Output, SlabMueller, Want, THICKNESS_MAX_NM};
+use crate::params::{Bandwidth, Thickness};
+use crate::plate::slab::{Output, SlabMueller, Want};
 use crate::plate::Plate;
 use crate::render::{PathLobe, Transport};
 use crate::spectral::integrate::{etalon_sum, integrate, integrate_set};
@@ -79,6 +80,15 @@ impl Spectrum {
         }
     }
 
+    /// Checks every band's wavelength and `filter_bandwidth` ([`Bandwidth`]), once per query.
+    fn validate(&self) -> Result<()> {
+        for (wavelength_nm, fwhm_nm) in self.bands() {
+            check_wavelength(wavelength_nm)?;
+            Bandwidth::new("filter_bandwidth", fwhm_nm, wavelength_nm)?;
+        }
+        Ok(())
+    }
+
     /// The single bands `(wavelength_nm, fwhm_nm)` of a [`Spectrum::Band`] or
     /// [`Spectrum::Bands`] (empty for weights).
     fn bands(&self) -> Vec<(f64, f64)> {
@@ -109,7 +119,7 @@ impl PlateQuery {
         ext: C64,
         exit: C64,
         axis: Vector3<f64>,
-        thickness_nm: f64,
+        thickness: Thickness,
         reflection: bool,
         transmission: bool,
         intensity_only: bool,
@@ -120,17 +130,8 @@ impl PlateQuery {
             ext: check_clear_index("ext_ior", ext)?,
             exit: check_clear_index("exit_ior", exit)?,
             axis: Uniaxial::new(C64::new(1.0, 0.0), C64::new(1.5, 0.0), axis)?.axis,
-            thickness_nm,
+            thickness_nm: thickness.nm(),
         };
-        if !((0.0..=THICKNESS_MAX_NM).contains(&thickness_nm)) {
-            return Err(Error::new(
-                "thickness",
-                format!(
-                    "must be within [0, 1e6] µm (1 m), got {} µm",
-                    thickness_nm * 1e-3
-                ),
-            ));
-        }
         Ok(PlateQuery {
             plate,
             want: Want {
@@ -198,6 +199,7 @@ fn lobes_of_plate(
         return Err(Error::new("wi", "must be a unit vector"));
     }
     let channels = spectrum.channels()?;
+    spectrum.validate()?;
     let mut out = vec![[None, None]; channels];
     if wi.z == 0.0 || (q.absorbing_exit && wi.z < 0.0) {
         return Ok(out);
@@ -320,7 +322,6 @@ fn physical_plate(
             .bands()
             .into_iter()
             .map(|(wavelength_nm, fwhm_nm)| {
-                check_bandwidth(fwhm_nm, wavelength_nm)?;
                 if is_exact_band(fwhm_nm, wavelength_nm) {
                     q.plate
                         .mueller_at(wavelength_nm, &frame, beta, want, q.output)
@@ -370,8 +371,6 @@ fn isotropic_plate(
             let mut incoherent = None;
             let mut ms = Vec::new();
             for (wavelength_nm, fwhm_nm) in spectrum.bands() {
-                check_wavelength(wavelength_nm)?;
-                check_bandwidth(fwhm_nm, wavelength_nm)?;
                 let m = if is_exact_band(fwhm_nm, wavelength_nm) {
                     etalon.mueller(wavelength_nm, q.want, q.output)
                 } else {
@@ -411,17 +410,4 @@ fn isotropic_plate(
             }
         }
     })
-}
-
-/// `filter_bandwidth` must be finite, `>= 0` and at most a quarter of the wavelength (a
-/// Gaussian in wavenumber then keeps all its weight far from `k = 0`).
-fn check_bandwidth(fwhm_nm: f64, wavelength_nm: f64) -> Result<()> {
-    if fwhm_nm.is_finite() && fwhm_nm >= 0.0 && fwhm_nm <= 0.25 * wavelength_nm {
-        Ok(())
-    } else {
-        Err(Error::new(
-            "filter_bandwidth",
-            format!("must be within [0, wavelength / 4] (nm), got {fwhm_nm} at {wavelength_nm} nm"),
-        ))
-    }
 }

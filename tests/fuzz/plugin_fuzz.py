@@ -8,7 +8,9 @@ input kept) instead of killing the fuzzer.
 Contract of every case (a violation is a finding):
 - `mi.load_dict` either returns a BSDF or raises a Python exception whose message is non-empty
   and names one of the dictionary's keys (a parameter, a nested texture's parameter, or the
-  value of the offending string parameter); never a crash;
+  value of the offending string parameter), and the parameter it names first is one the
+  dictionary gives (or one that a given one implies: `thickness` for `thickness_scale`), never
+  a name the user did not write; never a crash;
 - a loaded BSDF's `sample`, `eval`, `pdf` and `eval_null_transmission` on random surface
   interactions (random and grazing directions on both sides, random wavelengths and uv, both
   transport modes, random components) return finite numbers, a pdf >= 0 and a finite unit `wo`
@@ -71,11 +73,40 @@ def wrong_type(r: random.Random):
     return r.choice(["1.5", [1.0, 2.0], [], {"type": "nonexistent"}, True, 3, -7, [math.nan] * 3])
 
 
+def colour(r: random.Random):
+    """A number written as a colour: a grey or coloured rgb, a uniform or varying spectrum, an
+    srgb texture (the plugins read a grey rgb and a uniform spectrum as the number and refuse
+    the others, naming the parameter)."""
+    x = hostile_float(r)
+    k = r.randrange(5)
+    if k == 0:
+        return {"type": "rgb", "value": [x, x, x]}
+    if k == 1:
+        return {"type": "rgb", "value": [x, hostile_float(r), x]}
+    if k == 2:
+        return {"type": "spectrum", "value": x}
+    if k == 3:
+        return {"type": "spectrum", "value": [(400.0, x), (700.0, hostile_float(r))]}
+    return {"type": "srgb", "color": [r.random(), r.random(), r.random()]}
+
+
 def texture(r: random.Random):
-    """A float, or a checkerboard whose two values may be hostile (render-time values)."""
-    if r.random() < 0.6:
+    """A float, a colour, or a checkerboard whose two values may be hostile (render-time
+    values)."""
+    k = r.random()
+    if k < 0.5:
         return hostile_float(r) if r.random() < 0.95 else wrong_type(r)
+    if k < 0.65:
+        return colour(r)
     return {"type": "checkerboard", "color0": hostile_float(r), "color1": hostile_float(r)}
+
+
+def ior(r: random.Random):
+    """An index: a float, an IOR name, or (wrongly) a colour."""
+    k = r.random()
+    if k < 0.6:
+        return hostile_float(r)
+    return r.choice(IOR_NAMES) if k < 0.9 else colour(r)
 
 
 def axis(r: random.Random):
@@ -106,7 +137,7 @@ def case(seed: int, index: int) -> dict:
     if p() < 0.5:
         d["optic_axis"] = axis(r)
     if p() < 0.3:
-        d["ext_ior"] = hostile_float(r) if p() < 0.7 else r.choice(IOR_NAMES)
+        d["ext_ior"] = ior(r)
     if kind == "thinbirefringent":
         if p() < 0.6:
             d["thickness"] = texture(r)
@@ -117,7 +148,7 @@ def case(seed: int, index: int) -> dict:
             if p() < 0.25:
                 d[key] = texture(r)
         if p() < 0.3:
-            d["exit_ior"] = hostile_float(r) if p() < 0.7 else r.choice(IOR_NAMES)
+            d["exit_ior"] = ior(r)
     else:
         if p() < 0.3:
             d["optic_axis_space"] = r.choice(["local", "world", "object", ""])
@@ -187,6 +218,39 @@ def log_capture(mi):
 
 def internal_errors(messages) -> list[str]:
     return [m for m in messages if any(k in m for k in INTERNAL_MARKERS)]
+
+
+# A message may name a parameter the dictionary does not give when that parameter's default
+# is combined with one it does give (the plate's thickness is thickness x thickness_scale).
+# eta_o and eta_e go together (the one missing is named).
+IMPLIED_BY = {"thickness": {"thickness_scale"}, "birefringence": {"birefringence_scale"},
+              "exit_ior": {"ext_ior"}, "eta_o": {"eta_e"}, "eta_e": {"eta_o"}}
+
+
+def named_parameter(msg: str) -> str | None:
+    """The parameter a load error names first: `NAME: ...` / `NAME[i]: ...` (the core) or
+    `"NAME" ...` (the shim) after the plugin's tag, or Mitsuba's `property "NAME"`; None when
+    the message starts otherwise (e.g. a rule about several parameters)."""
+    import re
+
+    tags = [msg.rfind(t) for t in ("[ThinBirefringent] ", "[Birefringent] ")]
+    at = max(tags)
+    if at >= 0:
+        rest = msg[msg.index("] ", at) + 2:]
+        m = re.match(r'"([a-z_]+)"\s|([a-z_]+)(\[\d+\])?:\s', rest)
+        return (m.group(1) or m.group(2)) if m else None
+    m = re.search(r'property "([^"]+)"', msg)
+    return m.group(1) if m else None
+
+
+def names_a_given_parameter(msg: str, d: dict) -> bool:
+    """False when the message names a parameter that the dictionary does not give (and that
+    nothing it gives implies), e.g. `optic_axis` for a non-finite `axis_angle`."""
+    name = named_parameter(msg)
+    if name is None:
+        return True
+    given = keys_of(d)
+    return name in given or bool(IMPLIED_BY.get(name, set()) & given)
 
 
 def queries(mi, dr, bsdf, r: random.Random, n: int) -> str | None:
@@ -271,6 +335,9 @@ def worker(variant: str, seed: int, start: int, deadline: float, n_queries: int,
                 outcome = "FAIL empty error message"
             elif not any(k in msg for k in keys_of(d)):
                 outcome = f"FAIL error names no parameter: {type(ex).__name__}: {msg[:400]!r}"
+            elif not names_a_given_parameter(msg, d):
+                outcome = (f"FAIL error names {named_parameter(msg)!r}, which the dictionary does "
+                           f"not give: {msg[:400]!r}")
             elif internal_errors([msg]):
                 outcome = f"SOFT the core's internal error at load: {msg[:400]!r}"
         else:

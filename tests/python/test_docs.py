@@ -84,7 +84,7 @@ def test_plugin_readme_tables_are_generated_from_the_sources():
 def source_names(path: pathlib.Path) -> tuple[set[str], set[str]]:
     """(properties the plugin's constructor reads, parameters its `traverse` exposes)."""
     source = path.read_text()
-    read = r'(?:props\.\w+(?:<[^>]*>)?\(|parse_ior\(props,\s*)\s*"(\w+)"'
+    read = r'(?:props\.\w+(?:<[^>]*>)?\(|(?:parse_ior|scalar_texture<[^>]*>)\(\s*props,\s*)\s*"(\w+)"'
     names = set(re.findall(read, source))
     if "parse_material(props" in source:  # common.h reads the material properties
         common = (path.parent / "common.h").read_text()

@@ -46,3 +46,27 @@ def test_plugin_fuzzer_strict_fails_on_the_core_internal_error(tmp_path):
     assert strict.returncode == 1, strict.stdout + strict.stderr
     finding = json.loads((tmp_path / "strict" / "finding-scalar_spectral-seed1-case0.json").read_text())
     assert finding["finding"].startswith("SOFT the core's internal error"), finding
+
+
+def test_plugin_fuzzer_sees_a_message_naming_a_parameter_not_given():
+    """The fuzzer's naming contract catches the messages that once named the wrong parameter
+    (the rotated optic axis for a NaN axis_angle, the core's index for a kappa) and accepts a
+    name the dictionary gives or implies (thickness for thickness_scale, the missing eta_e)."""
+    sys.path.insert(0, str(FUZZER.parent))
+    import plugin_fuzz as f
+
+    tag = '[parser.cpp:1718] At dictionary node "root": failed ...: [ThinBirefringent] '
+    nan = float("nan")
+    assert not f.names_a_given_parameter(tag + "optic_axis[0]: must be a finite number, got NaN",
+                                         {"type": "thinbirefringent", "axis_angle": nan})
+    assert not f.names_a_given_parameter(tag + "eta_e: extinction coefficient (imaginary part) "
+                                         "must be <= 1000, got 1e300", {"kappa_e": 1e300})
+    assert f.names_a_given_parameter(tag + "axis_angle: must be a finite number (degrees), got nan",
+                                     {"axis_angle": nan})
+    assert f.names_a_given_parameter(tag + "thickness: must be within [0, 1e6] µm (1 m), got -2 µm",
+                                     {"thickness_scale": -2.0})
+    assert f.names_a_given_parameter(tag + '"eta_e" is missing ("eta_o" is given)', {"eta_o": 1.5})
+    assert f.names_a_given_parameter(tag + '"thickness" is a number (micrometres), not a colour',
+                                     {"thickness": {"type": "rgb", "value": [1, 2, 3]}})
+    assert f.names_a_given_parameter('The property "eta_o" has the wrong type', {"eta_o": "x"})
+    assert not f.names_a_given_parameter('The property "kappa_o" has the wrong type', {"kappa_e": "x"})

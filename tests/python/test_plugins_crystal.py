@@ -130,9 +130,10 @@ def test_flags_and_components():
     F = mi.BSDFFlags
     sides = F.FrontSide | F.BackSide | F.Anisotropic
     assert b.component_count() == 3
-    assert b.flags(0) == F.DeltaReflection | sides
-    assert b.flags(1) == F.DeltaTransmission | sides
-    assert b.flags(2) == F.DeltaTransmission | sides
+    # Inside calcite a reflection that converts o into e is between different ray indices.
+    assert b.flags(0) == F.DeltaReflection | sides | F.NonSymmetric
+    assert b.flags(1) == F.DeltaTransmission | sides | F.NonSymmetric
+    assert b.flags(2) == F.DeltaTransmission | sides | F.NonSymmetric
     assert b.flags() == b.flags(0) | b.flags(1) | b.flags(2)
     # eval and pdf of delta lobes are zero, like Mitsuba's delta BSDFs
     si = surface_interaction(direction(30, 20))
@@ -141,6 +142,38 @@ def test_flags_and_components():
     assert np.abs(np.array(b.eval(context(), si, bs.wo))).max() == 0.0
     iso = mi.load_dict({"type": "birefringent", "eta_o": 1.5, "eta_e": 1.5})
     assert not iso.flags() & F.Anisotropic
+
+
+@pytest.mark.parametrize("kind", ["isotropic", "calcite"])
+def test_non_symmetric_flag_matches_the_transport_modes(kind):
+    """A component is NonSymmetric exactly when the Radiance and Importance weights of one of
+    its lobes differ (the radiance factor (n_wi / n_wo)^2 of a lobe between different ray
+    indices: every refraction, and inside calcite the reflections that convert o into e), and
+    the flags of an isotropic crystal are those of Mitsuba's `dielectric`. Every lobe from
+    both sides at 30 degrees, matched by component and direction: a symmetric lobe's two
+    weights agree to float rounding (< 1e-6 relative), a non-symmetric one's differ by more
+    than 0.5 % here (the smallest: an o -> e reflection inside calcite, ratio 1.00996). An
+    isotropic crystal has no component 2 lobe (its refraction is component 1) and is compared
+    on components 0 and 1."""
+    variant(POLARIZED)
+    F = mi.BSDFFlags
+    params = {"eta_o": 1.5, "eta_e": 1.5} if kind == "isotropic" else {"material": "calcite"}
+    b = mi.load_dict({"type": "birefringent", "ext_ior": 1.0, "optic_axis": [0.3, 0.2, 0.9], **params})
+    if kind == "isotropic":
+        d = mi.load_dict({"type": "dielectric", "int_ior": 1.5, "ext_ior": 1.0})
+        assert [b.flags(c) for c in (0, 1)] == [d.flags(c) for c in (0, 1)]
+    differs = {}
+    for side in (1, -1):
+        si = surface_interaction(direction(30, 20, side))
+        rad, imp = lobes(b, context("radiance"), si), lobes(b, context("importance"), si)
+        assert len(rad) == len(imp)
+        for c, wo, m, _ in rad:
+            (m_i,) = [m2 for c2, wo2, m2, _ in imp if c2 == c and np.allclose(wo, wo2, atol=1e-6)]
+            ratio = m[0, 0, 0] / m_i[0, 0, 0]
+            assert abs(ratio - 1.0) < 1e-6 or abs(ratio - 1.0) > 5e-3, ratio
+            differs[c] = differs.get(c, False) or abs(ratio - 1.0) > 5e-3
+    assert sorted(differs) == ([0, 1] if kind == "isotropic" else [0, 1, 2])
+    assert differs == {c: mi.has_flag(b.flags(c), F.NonSymmetric) for c in differs}
 
 
 @pytest.mark.parametrize("side", [1, -1])

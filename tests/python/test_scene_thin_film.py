@@ -125,3 +125,50 @@ def test_rgb_bsdf_is_the_spectral_bsdf_integrated_with_mitsubas_tables():
         assert np.abs(rgb - spectral).max() < 2e-3, (d, rgb, spectral)
     assert negative >= 2, "no out-of-gamut case was exercised"
     print(f"scalar_rgb vs integrated scalar_spectral: worst {worst:.2e}")
+
+
+# A scalar_rgb render of the film in a fresh process (the log's appenders are those of a new
+# process): the render's log, then log lines of the kind the film emits, given by hand.
+SIGNED_RGB_WORKER = r"""
+import gc, json, sys
+import mitsuba as mi
+mi.set_variant("scalar_rgb")
+import mitsuba_birefringent
+sys.path.insert(0, sys.argv[1])
+import thin_film
+import numpy as np
+scene = mi.load_dict(thin_film.scene(width=12, height=12, spp=2))
+img = np.array(mi.render(scene))
+print("MIN_RED", float(img[..., 0].min()), flush=True)
+W = mi.LogLevel.Warn
+mi.Log(W, "[ImageBlock] Invalid sample value: [-0.5, 0.25, 0.25, 1]")   # finite: replaced
+mi.Log(W, "[ImageBlock] Invalid sample value: [nan, 0.25, 0.25, 1]")    # shown
+mi.Log(W, "[ImageBlock] Invalid sample value: [0.5, 0.25, 0.25, -1]")   # negative weight: shown
+del scene
+gc.collect()
+mi.Log(W, "[ImageBlock] Invalid sample value: [-0.25, 0.5, 0.5, 1]")    # no plate left: shown
+"""
+
+
+def test_signed_rgb_colours_warn_once_and_stay_signed():
+    """Out-of-gamut colours of the film in scalar_rgb are negative linear sRGB channels, the
+    values Mitsuba's spectral variants accumulate for them (its film does not check samples
+    there); the RGB film's per-sample warning about them ("Invalid sample value", formerly once
+    per sample: 20 in a 16 x 16, 2 spp render) is replaced by one notice with the reason, the
+    stored value stays negative, and non-finite or negative-weight samples are still reported,
+    as are negative colours once no scalar_rgb plate exists."""
+    import subprocess
+    import sys as _sys
+
+    scenes = str(pathlib.Path(__file__).resolve().parents[2] / "scenes")
+    out = subprocess.run([_sys.executable, "-c", SIGNED_RGB_WORKER, scenes], capture_output=True,
+                         text=True, timeout=300, check=True)
+    log = out.stdout + out.stderr
+    invalid = [line for line in log.splitlines() if "Invalid sample value" in line]
+    notices = [line for line in log.splitlines() if "Out-of-gamut colours" in line]
+    min_red = float(log.split("MIN_RED ")[1].split()[0])
+    print(f"min red channel {min_red:.4f}; notices {len(notices)}; other lines {invalid}")
+    assert min_red < -0.01  # kept signed (not clamped)
+    assert len(notices) == 1 and "[ThinBirefringent]" in notices[0]
+    assert [line.split("Invalid sample value: ")[1] for line in invalid if "Out-of-gamut" not in line] == [
+        "[nan, 0.25, 0.25, 1]", "[0.5, 0.25, 0.25, -1]", "[-0.25, 0.5, 0.5, 1]"]

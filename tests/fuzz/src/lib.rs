@@ -291,6 +291,46 @@ pub fn calc_document(b: &mut Bytes, slab: bool) -> String {
     Value::Object(o).to_string()
 }
 
+/// What a calculator error `e` may name (the text before its ": "): a field of the document
+/// (e.g. an unknown one), a field of the calculator (e.g. a missing one; an element `[i]` of a
+/// vector field), `spectrum.<field>` for a field of the spectrum object, the subject of an
+/// error about the whole input (`input`, `incidence`, `spectrum`, `subcommand`), or the object
+/// of a physically undefined query (`slab`: a diverging multiple-reflection sum, `interface`: a
+/// singular boundary system) — never a name of the core the user did not write (as
+/// `thickness` in nm for `thickness_um` once was).
+fn names_what_the_user_wrote(e: &str, text: &str) -> bool {
+    let doc: Value = serde_json::from_str(text).unwrap_or(Value::Null);
+    let keys = |v: &Value| -> Vec<String> {
+        v.as_object()
+            .map(|o| o.keys().cloned().collect())
+            .unwrap_or_default()
+    };
+    let spectrum = doc.get("spectrum").map(keys).unwrap_or_default();
+    let mut names: Vec<String> = keys(&doc);
+    names.extend(FIELDS.iter().map(|(f, _)| f.to_string()));
+    names.extend(
+        ["weights", "method", "step_nm", "bandwidth_nm"]
+            .iter()
+            .map(|s| s.to_string())
+            .chain(spectrum)
+            .map(|k| format!("spectrum.{k}")),
+    );
+    names.extend(
+        [
+            "input",
+            "incidence",
+            "spectrum",
+            "subcommand",
+            "slab",
+            "interface",
+        ]
+        .map(String::from),
+    );
+    names
+        .iter()
+        .any(|n| e.starts_with(&format!("{n}: ")) || e.starts_with(&format!("{n}[")))
+}
+
 /// The calculator's two internal errors (src/calc/mod.rs): a caught panic and a non-finite result.
 const INTERNAL_PANIC: &str = "internal error (a bug: please report the input)";
 const INTERNAL_NON_FINITE: &str = "output: non-finite value (a bug: please report the input)";
@@ -315,6 +355,7 @@ fn all_numbers_finite(v: &Value) -> bool {
 ///
 /// Panics (a fuzzer finding) when it does not hold.
 pub fn check_calc_output(sub: &str, text: &str, v: &Value, ok: bool) {
+    let document = text;
     let text: String = text.chars().take(2000).collect();
     serde_json::to_string_pretty(v).expect("output not serialisable");
     let o = v.as_object().expect("output not an object");
@@ -331,6 +372,10 @@ pub fn check_calc_output(sub: &str, text: &str, v: &Value, ok: bool) {
         assert!(
             e.contains(": "),
             "error does not name a parameter: {e} for {sub} {text}"
+        );
+        assert!(
+            names_what_the_user_wrote(e, document),
+            "error names neither a field of the input nor of the calculator: {e} for {sub} {text}"
         );
         return;
     }
