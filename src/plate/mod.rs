@@ -49,6 +49,14 @@ impl Plate {
         })
     }
 
+    /// The layer's normal components `[o↓, e↓, o↑, e↑]` at `lambda_nm` for incidence parameter
+    /// `beta` in the plane of `frame` (what [`Slab::layer_q`] gives, without building the slab).
+    pub fn layer_q(&self, lambda_nm: f64, frame: &PlaneFrame, beta: C64) -> Result<[C64; 4]> {
+        let (eo, ee) = self.material.indices(lambda_nm, self.birefringence)?;
+        let layer = Uniaxial::new(eo, ee, frame.to_working(self.axis))?;
+        Ok(crate::optics::modes::normal_components(&layer, beta))
+    }
+
     /// True if any index varies with wavelength.
     pub fn is_dispersive(&self) -> bool {
         self.material.is_dispersive()
