@@ -12,7 +12,7 @@ use crate::material::Material;
 use crate::optics::frame::PlaneFrame;
 use crate::optics::medium::Uniaxial;
 use crate::plate::etalon::Etalon;
-use crate::plate::slab::{Output, Slab, SlabMueller, Want};
+use crate::plate::slab::Slab;
 use nalgebra::Vector3;
 use num_complex::Complex64 as C64;
 
@@ -75,25 +75,5 @@ impl Plate {
             return None;
         }
         Etalon::new(self.ext, eo, self.exit, beta, self.thickness_nm)
-    }
-
-    /// The exact Mueller matrices at `lambda_nm` (s/p frames of `frame`), as `output` asks: the
-    /// isotropic fast path where it applies, else the general slab ([`Slab::optics`]).
-    pub fn mueller_at(
-        &self,
-        lambda_nm: f64,
-        frame: &PlaneFrame,
-        beta: C64,
-        want: Want,
-        output: Output,
-    ) -> Result<SlabMueller> {
-        match self.etalon(lambda_nm, beta) {
-            Some(e) => Ok(e.mueller(lambda_nm, want, output)),
-            None => Ok(output.keep(
-                self.at(lambda_nm)?
-                    .optics(frame, beta)?
-                    .mueller(lambda_nm, want)?,
-            )),
-        }
     }
 }

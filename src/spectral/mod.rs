@@ -8,6 +8,7 @@ pub mod group;
 pub mod hermite;
 pub mod integrate;
 pub mod interpolate;
+pub mod model;
 pub mod narrow;
 pub mod nodes;
 pub mod pairs;
