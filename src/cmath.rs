@@ -237,5 +237,4 @@ mod tests {
             assert!((spectral_norm(&a) - largest.sqrt()).abs() < 1e-12 * (1.0 + largest));
         }
     }
-
 }

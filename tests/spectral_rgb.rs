@@ -271,7 +271,12 @@ pub fn analytic(case: &Case) -> Colours {
     let mut out = [[0.0; 3]; 3];
     let ms = PlateModel::new(&case.plate, case.frame(), case.beta())
         .channels(SET, Want::BOTH, Output::Mueller, Accuracy::Perceptual)
-        .unwrap_or_else(|e| panic!("the analytic integration failed for {}: {e:?}", case.describe()));
+        .unwrap_or_else(|e| {
+            panic!(
+                "the analytic integration failed for {}: {e:?}",
+                case.describe()
+            )
+        });
     for (c, m) in ms.iter().enumerate() {
         for (q, v) in quantities(m).into_iter().enumerate() {
             out[q][c] = v;

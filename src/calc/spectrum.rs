@@ -37,9 +37,7 @@ pub fn run(input: &Value, fields: &[&str], spec: &Value) -> Result<Value> {
         _ => {
             return Err(Error::new(
                 "spectrum.method",
-                format!(
-                    "must be \"analytic\", \"exact\" or \"quadrature\", got \"{method}\""
-                ),
+                format!("must be \"analytic\", \"exact\" or \"quadrature\", got \"{method}\""),
             ))
         }
     };

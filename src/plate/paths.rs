@@ -189,7 +189,15 @@ impl PathExpansion {
             reflection.push(class([0; 4], 0, b.r1));
         }
         if merged {
-            let tail = Self::merged_classes(b, n_max, want, tail_at, &mut reflection, &mut transmission, &class);
+            let tail = Self::merged_classes(
+                b,
+                n_max,
+                want,
+                tail_at,
+                &mut reflection,
+                &mut transmission,
+                &class,
+            );
             return PathExpansion {
                 reflection,
                 transmission,
@@ -253,7 +261,11 @@ impl PathExpansion {
         for order in 0..=n_max {
             let n = order as u16;
             if want.transmission {
-                transmission.push(class([n + 1, 0, n, 0], order, cmath::mul2(&b.t2, &state) * ft));
+                transmission.push(class(
+                    [n + 1, 0, n, 0],
+                    order,
+                    cmath::mul2(&b.t2, &state) * ft,
+                ));
             }
             let up = cmath::mul2(&b.r2, &state);
             if want.reflection {
@@ -313,8 +325,9 @@ impl IncoherentTail {
                 ];
                 for (m, &r) in rows.iter().enumerate() {
                     total[(r, col)] = t[m];
-                    after_bottom[(r, col)] =
-                        (0..2).map(|k| t[k] * (pu[m] * pop(&b.r2, m, k))).sum::<C64>();
+                    after_bottom[(r, col)] = (0..2)
+                        .map(|k| t[k] * (pu[m] * pop(&b.r2, m, k)))
+                        .sum::<C64>();
                 }
             }
         }
@@ -348,7 +361,12 @@ impl IncoherentTail {
 
     /// The Mueller matrices of the internal sums leaving through the bottom (`total`, going
     /// down) and the top (`after_bottom`, going up).
-    fn leave(b: &SlabBlocks, total: &Matrix4<C64>, after_bottom: &Matrix4<C64>, want: Want) -> Self {
+    fn leave(
+        b: &SlabBlocks,
+        total: &Matrix4<C64>,
+        after_bottom: &Matrix4<C64>,
+        want: Want,
+    ) -> Self {
         let k = mueller::coherency;
         let ft = C64::new(b.flux.sqrt(), 0.0);
         IncoherentTail {

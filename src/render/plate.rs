@@ -317,9 +317,9 @@ fn evaluate(
     output: Output,
 ) -> Result<Vec<SlabMueller>> {
     match *spectrum {
-        Spectrum::Weights(set) => {
-            Ok(model.channels(set, want, output, Accuracy::Perceptual)?.to_vec())
-        }
+        Spectrum::Weights(set) => Ok(model
+            .channels(set, want, output, Accuracy::Perceptual)?
+            .to_vec()),
         _ => {
             // Bands thicker than the coherence length of an isotropic plate share one
             // incoherent sum.
@@ -348,7 +348,12 @@ fn physical_plate(
     want: Want,
 ) -> Result<Vec<SlabMueller>> {
     let (q, frame, beta, mirrored) = model_from(q, towards);
-    let ms = evaluate(&PlateModel::new(&q.plate, frame, beta), spectrum, want, q.output)?;
+    let ms = evaluate(
+        &PlateModel::new(&q.plate, frame, beta),
+        spectrum,
+        want,
+        q.output,
+    )?;
     let d = Matrix4::from_diagonal(&nalgebra::Vector4::new(1.0, 1.0, -1.0, -1.0));
     let fix = |m: Option<Matrix4<f64>>| m.map(|m| if mirrored { d * m * d } else { m });
     Ok(ms

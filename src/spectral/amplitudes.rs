@@ -18,7 +18,7 @@ use std::f64::consts::TAU;
 /// Amplitude nodes are added until the indices' interpolation between them is this close
 /// (relative) for a contribution of unit strength: the Fresnel amplitudes then follow to about
 /// the same relative accuracy (a few 1e-5 of the light, below what CIEDE2000 resolves).
-pub const INDEX_TOLERANCE: f64 = 1e-4;
+pub const INDEX_TOLERANCE: f64 = 3e-4;
 
 /// The blocks of a plate at the nodes of one level.
 pub struct Amplitudes {

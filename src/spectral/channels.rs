@@ -40,7 +40,10 @@ use crate::spectral::amplitudes::{traversal_q, Amplitudes};
 use crate::spectral::fringe::{self, FringeRule};
 use crate::spectral::hermite;
 use crate::spectral::nodes::{self, FINEST, LEVELS, MAX_NODES};
-use crate::spectral::pairs::{self, add_scaled, cross_add, dot, Group, Selection, INTENSITY_ENTRIES};
+use crate::spectral::pairs::{
+    self, add_scaled, cross_add, dot, Group, Pair, Selection, INTENSITY_ENTRIES,
+};
+use crate::spectral::shared;
 use crate::spectral::weights::{gaussians, WeightSet};
 use nalgebra::{Matrix2, Matrix4, Vector2};
 use num_complex::Complex64 as C64;
@@ -56,7 +59,9 @@ pub const ORDER_TAIL: f64 = 1e-5;
 pub const MAX_ORDER: usize = 8;
 
 /// `∫ w_c(k) M(k) dk` for the channels of `set` (module docs), or `None` if the plate needs more
-/// coherent orders than [`MAX_ORDER`] (thin plates of high index near grazing incidence).
+/// coherent orders than [`MAX_ORDER`] (thin plates of high index near grazing incidence) or the
+/// exact rule of its whole spectrum is cheaper (thin, strongly dispersive plates: many groups
+/// integrated Gaussian by Gaussian).
 pub fn channels(
     plate: &Plate,
     frame: &PlaneFrame,
@@ -87,7 +92,7 @@ pub fn channels(
         // The tail's share of the light, `Σ_{n>N} ρ^{2n}`, for its node level.
         tail_strength: rho.powi(2 * (order as i32 + 1)) / (1.0 - rho * rho),
     };
-    it.run().map(Some)
+    it.run()
 }
 
 /// The coherent order `N` and the round trip's spectral norm `ρ` (with its attenuation).
@@ -101,7 +106,7 @@ fn coherent_order(b: &SlabBlocks, round_trip: f64, rule: &FringeRule) -> Option<
     let pd = Matrix2::from_diagonal(&Vector2::new(att(b.q[0]), att(b.q[1])));
     let pu = Matrix2::from_diagonal(&Vector2::new(att(b.q[2]), att(b.q[3])));
     let rho = crate::cmath::spectral_norm(&(b.r3 * pu * b.r2 * pd));
-    if !(rho < 1.0) {
+    if rho.is_nan() || rho >= 1.0 {
         return None;
     }
     let sum = 1.0 / (1.0 - rho); // Σ over the pairs' common orders
@@ -161,15 +166,22 @@ struct Integration<'a> {
 }
 
 impl Integration<'_> {
-    fn run(&self) -> Result<[SlabMueller; 3]> {
+    /// The integration, or `None` if the exact rule of the plate's whole spectrum is cheaper.
+    fn run(&self) -> Result<Option<[SlabMueller; 3]>> {
         let lobes = [self.want.reflection, self.want.transmission];
         let tail_level = self.amplitudes.level_for(self.tail_strength);
         let centre = self.classes(0, 0, self.order, tail_level == 0);
         let mut placed: [Vec<Placed>; 2] = [Vec::new(), Vec::new()];
+        let mut pairs: [Vec<Pair>; 2] = [Vec::new(), Vec::new()];
         for lobe in 0..2 {
             if lobes[lobe] {
-                placed[lobe] = self.place(pairs::groups(&centre.lobes[lobe], &self.selection()));
+                let g = pairs::groups(&centre.lobes[lobe], &self.selection());
+                placed[lobe] = self.place(g.groups);
+                pairs[lobe] = g.pairs;
             }
+        }
+        if self.exact_is_cheaper(&placed, &pairs)? {
+            return Ok(None);
         }
         // The classes at every node of the amplitudes' level that a group or the tail uses,
         // each to the highest order needed there.
@@ -203,7 +215,7 @@ impl Integration<'_> {
                             .as_ref()
                             .expect("classes at every amplitude node a group uses");
                         let mut m = Matrix4::zeros();
-                        for (ca, cb, w) in &p.group.pairs {
+                        for (ca, cb, w) in &pairs[lobe][p.group.pairs.clone()] {
                             if let (Some(x), Some(y)) = (c.class(lobe, ca), c.class(lobe, cb)) {
                                 cross_add(&mut m, &x.amplitude, &y.amplitude, *w, intensity);
                             }
@@ -214,12 +226,6 @@ impl Integration<'_> {
             }
         }
         let q = self.phases(&placed)?;
-        if std::env::var("BFR_DEBUG").is_ok() {
-            for (lobe, list) in placed.iter().enumerate() {
-                eprintln!("lobe {lobe}: amp level {} order {} groups {:?}", self.amplitudes.level, self.order,
-                    list.iter().map(|p| (p.group.delta, p.group.order, p.group.pairs.len(), p.amplitude_level, p.level, (p.group.strength*1e6).round()/1e6, p.group.group_path.round(), (self.residual(&p.group)*1e3).round()/1e3)).collect::<Vec<_>>());
-            }
-        }
         let mut out = [SlabMueller { r: None, t: None }; 3];
         for lobe in 0..2 {
             if !lobes[lobe] {
@@ -244,7 +250,38 @@ impl Integration<'_> {
                 }
             }
         }
-        Ok(out.map(|m| self.output.keep(m)))
+        Ok(Some(out.map(|m| self.output.keep(m))))
+    }
+
+    /// True if the shared rule of the exact plate ([`crate::spectral::shared`]) costs less than
+    /// this integration would. Both costs are linear models fitted (least squares, median
+    /// relative error 14 %) to their measured times on the 500 validation plates of
+    /// `examples/bench_core.rs`, in microseconds of one core: this method `4.3` per amplitude
+    /// node, `0.12` per phase node of every group, `15` per group integrated Gaussian by
+    /// Gaussian, `0.62` per group and `0.031` per pair and amplitude node; the shared rule `0.34`
+    /// per point, and `112` for the interpolant of a dispersive plate's blocks. The shared
+    /// rule's plan (itself ~3 µs) is only asked for when the groups cost more than its cheapest
+    /// rule could.
+    fn exact_is_cheaper(&self, placed: &[Vec<Placed>; 2], pairs: &[Vec<Pair>; 2]) -> Result<bool> {
+        let amplitude_nodes = LEVELS[self.amplitudes.level] as f64;
+        let groups: f64 = placed
+            .iter()
+            .flatten()
+            .map(|p| 0.62 + p.level.map_or(15.0, |l| 0.12 * LEVELS[l] as f64))
+            .sum();
+        let pairs = 0.031 * amplitude_nodes * pairs.iter().map(|p| p.len()).sum::<usize>() as f64;
+        let ours = 4.3 * amplitude_nodes + groups + pairs;
+        let interpolant = if self.plate.is_dispersive() {
+            112.0
+        } else {
+            0.0
+        };
+        let exact = |points: f64| 0.34 * points + interpolant;
+        if ours <= exact(shared::LADDER[0] as f64) {
+            return Ok(false);
+        }
+        Ok(shared::plan(self.plate, self.frame, self.beta, self.set)?
+            .is_some_and(|points| exact(points as f64) < ours))
     }
 
     /// The index among the amplitudes' own nodes of node `i` of level `level`.
@@ -282,7 +319,7 @@ impl Integration<'_> {
             with_tail.then_some(TAU / (k0 + a * t)),
         );
         let sorted = |mut v: Vec<PathClass>| {
-            v.sort_by(|x, y| x.counts.cmp(&y.counts));
+            v.sort_by_key(|c| c.counts);
             v
         };
         Classes {
@@ -316,11 +353,15 @@ impl Integration<'_> {
         let (_, a) = fringe::band();
         let d = self.plate.thickness_nm;
         let q = traversal_q(&self.amplitudes.centre().q);
-        let x = a * d * (0..4).map(|m| f64::from(g.sum[m]) * q[m].im).sum::<f64>().abs();
+        let x = a
+            * d
+            * (0..4)
+                .map(|m| f64::from(g.sum[m]) * q[m].im)
+                .sum::<f64>()
+                .abs();
         let c = self.residual(g);
         let tolerance = NODE_ERROR / g.strength.max(1e-300);
-        (amplitude_level..LEVELS.len())
-            .find(|&l| interpolation_error(LEVELS[l], x, c) <= tolerance)
+        (amplitude_level..LEVELS.len()).find(|&l| interpolation_error(LEVELS[l], x, c) <= tolerance)
     }
 
     /// The largest residual phase `|φ_Δ(k) − φ_Δ(k₀) − G_Δ (k − k₀)|` of a group over the
@@ -364,7 +405,11 @@ impl Integration<'_> {
         for (&j, t) in lv.in_finest.iter().zip(&lv.nodes) {
             if q[j].is_none() {
                 q[j] = Some(if self.plate.is_dispersive() {
-                    traversal_q(&self.plate.layer_q(TAU / (k0 + a * t), self.frame, self.beta)?)
+                    traversal_q(
+                        &self
+                            .plate
+                            .layer_q(TAU / (k0 + a * t), self.frame, self.beta)?,
+                    )
                 } else {
                     traversal_q(&self.amplitudes.centre().q)
                 });
@@ -397,7 +442,9 @@ impl Integration<'_> {
             let mut per_node = [[C64::new(0.0, 0.0); 3]; MAX_NODES];
             for (i, &j) in nodes::level(level).in_finest.iter().enumerate() {
                 let k = k0 + a * finest[j];
-                let qj = q[j].as_ref().expect("a phase at every node of a used level");
+                let qj = q[j]
+                    .as_ref()
+                    .expect("a phase at every node of a used level");
                 let residual = k * d * dot(&g.delta, &qj.map(|x| x.re))
                     - k0 * d * dot(&g.delta, &self.centre_q)
                     - g.group_path * (k - k0);
@@ -448,37 +495,50 @@ impl Integration<'_> {
         let loss: Vec<f64> = (0..MAX_NODES)
             .map(|j| dot(&g.sum, &at(j).map(|x| x.im)))
             .collect();
+        let lossless = g.sum == [0; 4];
         let (phase, loss) = (nodes::chebyshev(&phase), nodes::chebyshev(&loss));
         // `iφ(k) − α(k)` at a complex wavenumber.
         let exponent = |k: C64| {
             let t = (k - k0) / a;
             let i = C64::new(0.0, 1.0);
-            k * d * (i * nodes::chebyshev_at(&phase, t) - nodes::chebyshev_at(&loss, t))
+            let alpha = if lossless {
+                C64::new(0.0, 0.0)
+            } else {
+                nodes::chebyshev_at(&loss, t)
+            };
+            k * d * (i * nodes::chebyshev_at(&phase, t) - alpha)
         };
         let amp = &nodes::level(p.amplitude_level).nodes;
         let mut basis = [C64::new(0.0, 0.0); MAX_NODES];
-        for (c, acc_c) in acc.iter_mut().enumerate() {
+        // Σ over the Gaussians of each amplitude node's weight, per channel.
+        let mut per_node = [[C64::new(0.0, 0.0); 3]; MAX_NODES];
+        for c in 0..3 {
             for gauss in gaussians(self.set, c) {
                 let mu = gauss.mu;
                 let t = (mu - k0) / a;
                 let (f, f1, f2) = nodes::chebyshev_eval(&phase, t);
-                let (s, s1, s2) = nodes::chebyshev_eval(&loss, t);
+                let (s, s1, s2) = if lossless {
+                    (0.0, 0.0, 0.0)
+                } else {
+                    nodes::chebyshev_eval(&loss, t)
+                };
                 // b = d(k f)/dk + i d(k s)/dk, c likewise of second order; d/dk = (1/a) d/dt.
                 let (f1, f2, s1, s2) = (f1 / a, f2 / (a * a), s1 / a, s2 / (a * a));
                 let b = C64::new(d * (f + mu * f1), d * (s + mu * s1));
-                let c = C64::new(d * (2.0 * f1 + mu * f2), d * (2.0 * s1 + mu * s2));
+                let curvature = C64::new(d * (2.0 * f1 + mu * f2), d * (2.0 * s1 + mu * s2));
                 let centre = exponent(C64::new(mu, 0.0));
-                let closed = gaussian_fringe(gauss, b, c);
+                let closed = gaussian_fringe(gauss, b, curvature);
                 if closed.norm() * g.strength < NEGLIGIBLE_TERM {
                     continue;
                 }
-                let width2 = gauss.sigma * gauss.sigma / (1.0 - C64::new(0.0, 1.0) * c * gauss.sigma * gauss.sigma);
+                let width2 = gauss.sigma * gauss.sigma
+                    / (1.0 - C64::new(0.0, 1.0) * curvature * gauss.sigma * gauss.sigma);
                 let width = crate::cmath::sqrt(width2);
                 let shift = C64::new(mu, 0.0) + C64::new(0.0, 1.0) * width2 * b;
                 let i = C64::new(0.0, 1.0);
                 let remainder = |k: C64| {
                     let x = k - mu;
-                    exponent(k) - centre - i * b * x - 0.5 * i * c * x * x
+                    exponent(k) - centre - i * b * x - 0.5 * i * curvature * x * x
                 };
                 // The cubic and higher terms two widths out (`r`) decide the points.
                 let weight = closed.norm() * g.strength;
@@ -494,19 +554,20 @@ impl Integration<'_> {
                         .find(|(_, error)| weight * error(r) <= NODE_ERROR * 1e-1)
                         .map_or(GAUSS_HERMITE[GAUSS_HERMITE.len() - 1].0, |p| p.0)
                 };
-                let mut per_node = [C64::new(0.0, 0.0); MAX_NODES];
+                let scale = centre.exp() * closed;
                 for &(z, w) in hermite::rule(points) {
                     let k = shift + width * z;
                     nodes::lagrange(amp, (k - k0) / a, &mut basis);
-                    let factor = remainder(k).exp() * w;
+                    let factor = remainder(k).exp() * w * scale;
                     for (pn, l) in per_node.iter_mut().zip(&basis[..amp.len()]) {
-                        *pn += l * factor;
+                        pn[c] += l * factor;
                     }
                 }
-                let scale = centre.exp() * closed;
-                for (m, w) in p.amplitude.iter().zip(&per_node) {
-                    add_scaled(acc_c, m, w * scale, intensity);
-                }
+            }
+        }
+        for (m, w) in p.amplitude.iter().zip(&per_node) {
+            for (c, acc_c) in acc.iter_mut().enumerate() {
+                add_scaled(acc_c, m, w[c], intensity);
             }
         }
     }

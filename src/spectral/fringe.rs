@@ -71,12 +71,8 @@ fn add_gaussian(g: &Gaussian, x: &[f64], big_g: f64, acc: &mut [C64], scratch: &
     let (k0, a) = band();
     let n = x.len();
     let gh = hermite::rule(n.div_ceil(2));
-    let envelope = C64::new(
-        -0.5 * (g.sigma * big_g).powi(2),
-        big_g * (g.mu - k0),
-    )
-    .exp()
-        * g.amplitude;
+    let envelope =
+        C64::new(-0.5 * (g.sigma * big_g).powi(2), big_g * (g.mu - k0)).exp() * g.amplitude;
     let centre = C64::new(g.mu - k0, g.sigma * g.sigma * big_g) / a;
     for &(z, w) in gh {
         lagrange(x, centre + g.sigma / a * z, scratch);
@@ -105,8 +101,8 @@ impl FringeRule {
                 }) {
                     add_gaussian(g, &x, big_g, &mut acc, &mut scratch);
                 }
-                for (i, v) in acc.iter().enumerate() {
-                    table[m * n + i][c] = *v;
+                for (entry, v) in table[m * n..m * n + n].iter_mut().zip(&acc) {
+                    entry[c] = *v;
                 }
                 let total: C64 = acc.iter().sum();
                 visibility[m] = f64::max(visibility[m], total.norm());
@@ -133,7 +129,7 @@ impl FringeRule {
     /// `max_c |F_c(G)|`: how visible a fringe of group path `G` with a constant amplitude is in
     /// the most sensitive channel (1 at `G = 0`, nearest table row).
     pub fn visibility(&self, g: f64) -> f64 {
-        let m = (g.abs() / STEP_NM).round() as usize;
+        let m = (g.abs() * (1.0 / STEP_NM)).round() as usize;
         if m >= self.rows - 2 {
             0.0
         } else {
@@ -146,7 +142,9 @@ impl FringeRule {
         let n = self.nodes.len();
         let s = g.abs() / STEP_NM;
         let m = s.floor() as usize;
-        out[..n].iter_mut().for_each(|o| *o = [C64::new(0.0, 0.0); 3]);
+        out[..n]
+            .iter_mut()
+            .for_each(|o| *o = [C64::new(0.0, 0.0); 3]);
         if m + 2 >= self.rows {
             return;
         }
@@ -216,7 +214,11 @@ mod tests {
                 let mut w = vec![[C64::new(0.0, 0.0); 3]; n];
                 let p = |k: f64| {
                     let t = (k - k0) / a;
-                    let linear = if n > 1 { C64::new(-0.2, 0.3) * t } else { C64::new(0.0, 0.0) };
+                    let linear = if n > 1 {
+                        C64::new(-0.2, 0.3) * t
+                    } else {
+                        C64::new(0.0, 0.0)
+                    };
                     C64::new(0.7, 0.3) * t.powi(n as i32 - 1) + linear + C64::new(1.0, -0.5)
                 };
                 let mut worst = 0.0f64;

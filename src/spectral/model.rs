@@ -103,8 +103,7 @@ impl<'a> PlateModel<'a> {
     ) -> Result<[SlabMueller; 3]> {
         if self.etalon.is_some() {
             let mut incoherent = None;
-            let mut one =
-                |c: usize| self.band(gaussians(set, c), want, output, &mut incoherent);
+            let mut one = |c: usize| self.band(gaussians(set, c), want, output, &mut incoherent);
             return Ok([one(0)?, one(1)?, one(2)?]);
         }
         if accuracy == Accuracy::Perceptual {

@@ -22,7 +22,11 @@ pub fn lobatto(n: usize) -> Vec<f64> {
     }
     (0..n)
         .map(|i| {
-            let (j, sign) = if 2 * i < n - 1 { (i, 1.0) } else { (n - 1 - i, -1.0) };
+            let (j, sign) = if 2 * i < n - 1 {
+                (i, 1.0)
+            } else {
+                (n - 1 - i, -1.0)
+            };
             if 2 * j == n - 1 {
                 0.0
             } else {
@@ -39,7 +43,10 @@ pub fn lagrange(x: &[f64], z: C64, out: &mut [C64]) {
         out[0] = C64::new(1.0, 0.0);
         return;
     }
-    if let Some(j) = x.iter().position(|&xi| z == C64::new(xi, 0.0)) {
+    if let Some(j) = (z.im == 0.0)
+        .then(|| x.iter().position(|&xi| z.re == xi))
+        .flatten()
+    {
         out[..n].iter_mut().enumerate().for_each(|(i, o)| {
             *o = C64::new(if i == j { 1.0 } else { 0.0 }, 0.0);
         });
@@ -48,7 +55,11 @@ pub fn lagrange(x: &[f64], z: C64, out: &mut [C64]) {
     let mut total = C64::new(0.0, 0.0);
     for (i, &xi) in x.iter().enumerate() {
         let sign = if i % 2 == 0 { 1.0 } else { -1.0 };
-        let w = if i == 0 || i == n - 1 { 0.5 * sign } else { sign };
+        let w = if i == 0 || i == n - 1 {
+            0.5 * sign
+        } else {
+            sign
+        };
         out[i] = w / (z - xi);
         total += out[i];
     }
@@ -210,20 +221,31 @@ mod tests {
     #[test]
     fn levels_are_nested_and_interpolate_polynomials() {
         let finest = &level(FINEST).nodes;
-        for l in 0..LEVELS.len() {
+        for (l, &n) in LEVELS.iter().enumerate() {
             let lv = level(l);
-            assert_eq!(lv.nodes.len(), LEVELS[l]);
+            assert_eq!(lv.nodes.len(), n);
             for (i, &j) in lv.in_finest.iter().enumerate() {
                 assert_eq!(finest[j], lv.nodes[i]);
             }
             // A polynomial of degree n − 1 is reproduced at every finest node, and its
             // derivative at 0 by the slope weights.
-            let n = LEVELS[l];
-            let p = |t: f64| (0..n).map(|m| (0.3 + m as f64) * t.powi(m as i32)).sum::<f64>();
+            let p = |t: f64| {
+                (0..n)
+                    .map(|m| (0.3 + m as f64) * t.powi(m as i32))
+                    .sum::<f64>()
+            };
             let dp0 = if n > 1 { 1.3 } else { 0.0 };
             for (j, &t) in finest.iter().enumerate() {
-                let v: f64 = lv.nodes.iter().zip(&lv.to_finest[j]).map(|(&x, w)| p(x) * w).sum();
-                assert!((v - p(t)).abs() < 1e-12 * (1.0 + p(t).abs()), "level {l} at {t}");
+                let v: f64 = lv
+                    .nodes
+                    .iter()
+                    .zip(&lv.to_finest[j])
+                    .map(|(&x, w)| p(x) * w)
+                    .sum();
+                assert!(
+                    (v - p(t)).abs() < 1e-12 * (1.0 + p(t).abs()),
+                    "level {l} at {t}"
+                );
             }
             let d: f64 = lv.nodes.iter().zip(&lv.slope).map(|(&x, w)| p(x) * w).sum();
             assert!((d - dp0).abs() < 1e-12, "level {l}: slope {d}");

@@ -23,8 +23,8 @@ pub struct Group {
     /// `counts_a + counts_b` of its pairs in an absorbing layer (their attenuation is
     /// `e^{−k d Σ_m sum_m Im Q_m}`), else zero.
     pub sum: [i32; 4],
-    /// `(a, b, weight)`: the classes' counts, and 1 for `a = b`, 2 otherwise.
-    pub pairs: Vec<(Counts, Counts, f64)>,
+    /// Its pairs: a range of [`Groups::pairs`].
+    pub pairs: std::ops::Range<usize>,
     /// `Σ weight |A_a| |A_b|` at the centre.
     pub strength: f64,
     /// Its group path at the centre (nm).
@@ -46,6 +46,17 @@ fn is_canonical(d: &[i32; 4]) -> bool {
     d.iter().find(|x| **x != 0).is_none_or(|x| *x > 0)
 }
 
+/// One pair: the classes' counts, and 1 for `a = b`, 2 otherwise.
+pub type Pair = (Counts, Counts, f64);
+
+/// The groups of one lobe and their pairs (each group's pairs are a range of them).
+pub struct Groups {
+    /// The groups.
+    pub groups: Vec<Group>,
+    /// Every pair, group by group.
+    pub pairs: Vec<Pair>,
+}
+
 /// What decides which pairs are kept.
 pub struct Selection<'a> {
     /// Plate thickness (nm).
@@ -64,7 +75,7 @@ pub struct Selection<'a> {
 /// attenuation), each with its group path and strength; invisible groups dropped (the `Δ = 0`
 /// groups, the incoherent sums, are always kept). Pairs weaker than a thousandth of
 /// [`Selection::drop`] are not formed at all.
-pub fn groups(classes: &[PathClass], s: &Selection) -> Vec<Group> {
+pub fn groups(classes: &[PathClass], s: &Selection) -> Groups {
     let d = s.thickness_nm;
     // Classes by decreasing amplitude: the inner loop stops at the first pair too weak to
     // matter even at full visibility. Each class's group path, so that a pair's is a
@@ -112,12 +123,18 @@ pub fn groups(classes: &[PathClass], s: &Selection) -> Vec<Group> {
     }
     pairs.sort_unstable_by_key(|p| (p.0, p.1, p.2));
     let mut out: Vec<Group> = Vec::new();
+    let mut all: Vec<Pair> = Vec::with_capacity(pairs.len());
     let mut last_key = u64::MAX;
     for (k, a, b, amp) in pairs {
-        let pair = (classes[a].counts, classes[b].counts, if a == b { 1.0 } else { 2.0 });
+        all.push((
+            classes[a].counts,
+            classes[b].counts,
+            if a == b { 1.0 } else { 2.0 },
+        ));
+        let end = all.len();
         match out.last_mut() {
             Some(g) if k == last_key => {
-                g.pairs.push(pair);
+                g.pairs.end = end;
                 g.strength += amp;
             }
             _ => {
@@ -133,7 +150,7 @@ pub fn groups(classes: &[PathClass], s: &Selection) -> Vec<Group> {
                     delta,
                     order: classes[a].order.max(classes[b].order),
                     sum,
-                    pairs: vec![pair],
+                    pairs: end - 1..end,
                     strength: amp,
                     group_path: d * dot(&delta, &s.group),
                 });
@@ -142,7 +159,10 @@ pub fn groups(classes: &[PathClass], s: &Selection) -> Vec<Group> {
         }
     }
     out.retain(|g| g.delta == [0; 4] || g.strength * s.rule.visibility(g.group_path) >= s.drop);
-    out
+    Groups {
+        groups: out,
+        pairs: all,
+    }
 }
 
 /// A pair weaker than this share of [`Selection::drop`] (times its visibility) is not formed:
@@ -169,7 +189,13 @@ pub const INTENSITY_ENTRIES: [(usize, usize); 4] = [(0, 0), (0, 3), (3, 0), (3, 
 
 /// `acc += s conj(x) ⊗ y` (all 16 entries, or with `intensity` only [`INTENSITY_ENTRIES`]).
 #[inline]
-pub fn cross_add(acc: &mut Matrix4<C64>, x: &Matrix2<C64>, y: &Matrix2<C64>, s: f64, intensity: bool) {
+pub fn cross_add(
+    acc: &mut Matrix4<C64>,
+    x: &Matrix2<C64>,
+    y: &Matrix2<C64>,
+    s: f64,
+    intensity: bool,
+) {
     let xc = [
         x[(0, 0)].conj() * s,
         x[(0, 1)].conj() * s,
