@@ -98,6 +98,21 @@ pub fn from_coherency(k: &Matrix4<C64>) -> Matrix4<f64> {
     })
 }
 
+/// The Mueller matrix of the reversed path, `Q Mᵀ Q` with `Q = diag(1, 1, −1, 1)`: the
+/// reciprocity theorem for media with symmetric dielectric tensors (Z. Sekera, JOSA 56, 1732,
+/// 1966), in Mitsuba's Stokes convention with each beam's frame keeping its `x` axis (the
+/// reversed beam's `y = k × x` changes sign, and with it `U`). Light from `−wo` that reaches
+/// `wi` retraces the wave that went from `−wi` to `wo`, so one forward solve gives both
+/// transport modes of a lobe.
+pub fn reversed(m: &Matrix4<f64>) -> Matrix4<f64> {
+    let mut r = m.transpose();
+    for i in 0..4 {
+        r[(i, 2)] = -r[(i, 2)];
+        r[(2, i)] = -r[(2, i)];
+    }
+    r
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

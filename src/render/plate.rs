@@ -8,6 +8,7 @@ use crate::material::check_clear_index;
 use crate::material::{check_wavelength, Material};
 use crate::optics::frame::PlaneFrame;
 use crate::optics::medium::Uniaxial;
+use crate::optics::mueller::reversed;
 use crate::params::{Bandwidth, Thickness};
 use crate::plate::slab::{Output, SlabMueller, Want};
 use crate::plate::Plate;
@@ -165,8 +166,10 @@ impl PlateQuery {
 }
 
 /// The plate's lobes seen from `wi`, one `[reflection, transmission]` pair per spectral
-/// channel (one for [`Spectrum::Band`]). An isotropic plate ([`Plate::etalon`]) is solved once
-/// for both lobes (by reciprocity; `isotropic_plate` in this module).
+/// channel (one for [`Spectrum::Band`]). The plate is solved once, from `wi`'s side, for both
+/// lobes: in Importance mode that is each lobe's own incidence; in Radiance mode (light from
+/// the mirror direction, or from the far side) each lobe is the reversed path of the forward
+/// one ([`reversed`], the reciprocity of media with symmetric dielectric tensors).
 pub fn plate_lobes(
     q: &PlateQuery,
     spectrum: &Spectrum,
@@ -176,8 +179,8 @@ pub fn plate_lobes(
     lobes_of_plate(q, spectrum, wi, transport, true)
 }
 
-/// [`plate_lobes`] with each lobe solved on its own (the light's own side and direction): the
-/// reference the shared isotropic solution is tested against.
+/// [`plate_lobes`] with each lobe solved on its own (the light's own side and direction, by
+/// time reversal in Radiance mode): the reference the shared solution is tested against.
 pub fn plate_lobes_full(
     q: &PlateQuery,
     spectrum: &Spectrum,
@@ -208,22 +211,21 @@ fn lobes_of_plate(
     let q = &q;
     let wi = wi.normalize();
     let reflected = Vector3::new(-wi.x, -wi.y, wi.z);
-    let through = through_plate(q, wi);
+    let lobes = [
+        Some(reflected).filter(|_| q.want.reflection),
+        through_plate(q, wi).filter(|_| q.want.transmission),
+    ];
     let shared = if share {
-        isotropic_plate(q, spectrum, wi)?
+        let want = Want {
+            reflection: lobes[0].is_some(),
+            transmission: lobes[1].is_some(),
+        };
+        Some(physical_plate(q, spectrum, wi, want)?)
     } else {
         None
     };
-    let lobes = [(0, Some(reflected)), (1, through)];
-    for (component, wo) in lobes {
-        let wanted = if component == 0 {
-            q.want.reflection
-        } else {
-            q.want.transmission
-        };
-        let Some(wo) = wo.filter(|_| wanted) else {
-            continue;
-        };
+    for (component, wo) in lobes.into_iter().enumerate() {
+        let Some(wo) = wo else { continue };
         let towards = match transport {
             Transport::Importance => wi,
             Transport::Radiance => wo,
@@ -232,12 +234,13 @@ fn lobes_of_plate(
             reflection: component == 0,
             transmission: component == 1,
         };
+        // Shared: solved from wi's side; a Radiance lobe is its reversed path.
         let own;
-        let ms: &[SlabMueller] = match &shared {
-            Some(ms) => ms,
+        let (ms, reverse): (&[SlabMueller], bool) = match &shared {
+            Some(ms) => (ms, transport == Transport::Radiance),
             None => {
                 own = physical_plate(q, spectrum, towards, want)?;
-                &own
+                (&own, false)
             }
         };
         let (n_in, n_out) = side_indices(q, towards, component);
@@ -249,7 +252,7 @@ fn lobes_of_plate(
         for (c, m) in ms.iter().enumerate() {
             let m = if component == 0 { m.r } else { m.t };
             let Some(m) = m else { continue };
-            let mut mueller = m * scale;
+            let mut mueller = if reverse { reversed(&m) } else { m } * scale;
             // A band-averaged coherency of a plate that passes (almost) nothing can give M00 a
             // rounding-level negative (seen: -2e-22); under a non-negative weight the
             // unpolarised throughput is >= 0. (A signed sRGB channel keeps its sign.)
@@ -363,24 +366,4 @@ fn physical_plate(
             t: fix(m.t),
         })
         .collect())
-}
-
-/// The isotropic fast path of [`plate_lobes`]: a plate whose model is an etalon is solved once,
-/// from `wi`'s side, for both lobes. Reflection in Radiance mode (light from the mirror
-/// direction) sees the same incidence; transmission in Radiance mode (light from the far side)
-/// has the same Mueller matrix by reciprocity: the flux-normalised amplitudes of a lossless
-/// isotropic plate are equal both ways (`τ(1→3) = τ(3→1)`, checked against per-lobe solutions
-/// in `tests/isotropic_fast_path.rs`), and its Mueller matrices are diagonal-block, unchanged
-/// by the mirroring of a plate seen from below. `None` where the model is not an etalon.
-fn isotropic_plate(
-    q: &PlateQuery,
-    spectrum: &Spectrum,
-    wi: Vector3<f64>,
-) -> Result<Option<Vec<SlabMueller>>> {
-    let (q, frame, beta, _) = model_from(q, wi);
-    let model = PlateModel::new(&q.plate, frame, beta);
-    if model.etalon().is_none() {
-        return Ok(None);
-    }
-    evaluate(&model, spectrum, q.want, q.output).map(Some)
 }

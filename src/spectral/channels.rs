@@ -26,7 +26,7 @@
 //! CIELAB is steepest (`L* = 903 Y`, `a* ≈ 3900 (X − Y)`), an error of 1e-4 in a channel is
 //! already 0.4, so every approximation here is held to 1e-5: [`DROP`] per dropped group,
 //! [`NODE_ERROR`] per group for its nodes, [`ORDER_TAIL`] for the coherence of the orders left
-//! to the tail, and [`crate::spectral::amplitudes::INDEX_TOLERANCE`] (relative) for the
+//! to the tail, and [`crate::spectral::amplitudes::AMPLITUDE_TOLERANCE`] for the
 //! amplitudes. The fits of the weights add their own error (1.7e-3 to 7.9e-3 in L1, mostly at
 //! path differences beyond 10 µm), which dominates (`tests/spectral_rgb.rs`).
 
@@ -36,7 +36,7 @@ use crate::optics::mueller;
 use crate::plate::paths::{Counts, PathClass, PathExpansion};
 use crate::plate::slab::{Output, SlabBlocks, SlabMueller, Want};
 use crate::plate::Plate;
-use crate::spectral::amplitudes::{traversal_q, Amplitudes};
+use crate::spectral::amplitudes::{least_attenuation, traversal_q, Amplitudes};
 use crate::spectral::fringe::{self, FringeRule};
 use crate::spectral::hermite;
 use crate::spectral::nodes::{self, FINEST, LEVELS, MAX_NODES};
@@ -59,9 +59,10 @@ pub const ORDER_TAIL: f64 = 1e-5;
 pub const MAX_ORDER: usize = 8;
 
 /// `∫ w_c(k) M(k) dk` for the channels of `set` (module docs), or `None` if the plate needs more
-/// coherent orders than [`MAX_ORDER`] (thin plates of high index near grazing incidence) or the
-/// exact rule of its whole spectrum is cheaper (thin, strongly dispersive plates: many groups
-/// integrated Gaussian by Gaussian).
+/// coherent orders than [`MAX_ORDER`] (thin plates of high index near grazing incidence),
+/// or a wave in it turns evanescent inside the band ([`least_attenuation`]). Where the shared rule
+/// of the exact plate costs less (thin, strongly dispersive plates: many groups integrated
+/// Gaussian by Gaussian), that rule integrates it.
 pub fn channels(
     plate: &Plate,
     frame: &PlaneFrame,
@@ -71,6 +72,9 @@ pub fn channels(
     output: Output,
 ) -> Result<Option<[SlabMueller; 3]>> {
     let amplitudes = Amplitudes::new(plate, frame, beta)?;
+    let Some(loss) = least_attenuation(plate, frame, beta, &amplitudes.centre().q)? else {
+        return Ok(None);
+    };
     let group = amplitudes.group_indices();
     // The shortest round trip's group path (nm): o or e down, o or e up.
     let round_trip = plate.thickness_nm * (group[0].min(group[1]) + group[2].min(group[3]));
@@ -86,6 +90,7 @@ pub fn channels(
         want,
         output,
         group,
+        loss,
         centre_q: traversal_q(&amplitudes.centre().q).map(|q| q.re),
         amplitudes,
         order,
@@ -159,6 +164,8 @@ struct Integration<'a> {
     order: usize,
     /// Group index per traversal at the centre (`d(k Re Q)/dk`).
     group: [f64; 4],
+    /// The least attenuation exponent per traversal over the band.
+    loss: [f64; 4],
     /// `Re Q` per traversal at the centre.
     centre_q: [f64; 4],
     /// The incoherent tail's strength (relative to the direct light).
@@ -166,7 +173,7 @@ struct Integration<'a> {
 }
 
 impl Integration<'_> {
-    /// The integration, or `None` if the exact rule of the plate's whole spectrum is cheaper.
+    /// The integration (by the shared exact rule where that is cheaper).
     fn run(&self) -> Result<Option<[SlabMueller; 3]>> {
         let lobes = [self.want.reflection, self.want.transmission];
         let tail_level = self.amplitudes.level_for(self.tail_strength);
@@ -180,8 +187,17 @@ impl Integration<'_> {
                 pairs[lobe] = g.pairs;
             }
         }
-        if self.exact_is_cheaper(&placed, &pairs)? {
-            return Ok(None);
+        if let Some(points) = self.cheaper_exact_rule(&placed, &pairs)? {
+            return shared::quadrature(
+                self.plate,
+                self.frame,
+                self.beta,
+                self.set,
+                points,
+                self.want,
+                self.output,
+            )
+            .map(Some);
         }
         // The classes at every node of the amplitudes' level that a group or the tail uses,
         // each to the highest order needed there.
@@ -253,8 +269,8 @@ impl Integration<'_> {
         Ok(Some(out.map(|m| self.output.keep(m))))
     }
 
-    /// True if the shared rule of the exact plate ([`crate::spectral::shared`]) costs less than
-    /// this integration would. Both costs are linear models fitted (least squares, median
+    /// The points of the shared rule of the exact plate ([`crate::spectral::shared`]) if it
+    /// costs less than this integration would. Both costs are linear models fitted (least squares, median
     /// relative error 14 %) to their measured times on the 500 validation plates of
     /// `examples/bench_core.rs`, in microseconds of one core: this method `4.3` per amplitude
     /// node, `0.12` per phase node of every group, `15` per group integrated Gaussian by
@@ -262,7 +278,11 @@ impl Integration<'_> {
     /// per point, and `112` for the interpolant of a dispersive plate's blocks. The shared
     /// rule's plan (itself ~3 µs) is only asked for when the groups cost more than its cheapest
     /// rule could.
-    fn exact_is_cheaper(&self, placed: &[Vec<Placed>; 2], pairs: &[Vec<Pair>; 2]) -> Result<bool> {
+    fn cheaper_exact_rule(
+        &self,
+        placed: &[Vec<Placed>; 2],
+        pairs: &[Vec<Pair>; 2],
+    ) -> Result<Option<usize>> {
         let amplitude_nodes = LEVELS[self.amplitudes.level] as f64;
         let groups: f64 = placed
             .iter()
@@ -278,10 +298,10 @@ impl Integration<'_> {
         };
         let exact = |points: f64| 0.34 * points + interpolant;
         if ours <= exact(shared::LADDER[0] as f64) {
-            return Ok(false);
+            return Ok(None);
         }
         Ok(shared::plan(self.plate, self.frame, self.beta, self.set)?
-            .is_some_and(|points| exact(points as f64) < ours))
+            .filter(|&points| exact(points as f64) < ours))
     }
 
     /// The index among the amplitudes' own nodes of node `i` of level `level`.
@@ -302,6 +322,7 @@ impl Integration<'_> {
             absorbing: traversal_q(&self.amplitudes.centre().q)
                 .iter()
                 .any(|q| q.im != 0.0),
+            loss: self.loss,
             rule: fringe::rule(self.set, 0),
             drop: DROP,
         }

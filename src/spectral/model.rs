@@ -16,12 +16,13 @@ use crate::band::Gaussian;
 use crate::error::Result;
 use crate::optics::frame::PlaneFrame;
 use crate::plate::etalon::Etalon;
-use crate::plate::slab::{Output, SlabMueller, Want};
+use crate::plate::slab::{Output, SlabMueller, SlabOptics, Want};
 use crate::plate::Plate;
 use crate::spectral::channels;
 use crate::spectral::integrate::{etalon_sum, integrate, integrate_set_exact};
 use crate::spectral::weights::{gaussians, WeightSet};
 use num_complex::Complex64 as C64;
+use std::cell::OnceCell;
 
 /// How exactly a channel set is integrated.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -40,6 +41,9 @@ pub struct PlateModel<'a> {
     frame: PlaneFrame,
     beta: C64,
     etalon: Option<Etalon>,
+    /// Without dispersion the interfaces do not depend on the wavelength: solved once, for
+    /// every wavelength asked of this model (the four a spectral renderer traces along a path).
+    fixed: OnceCell<SlabOptics>,
 }
 
 impl<'a> PlateModel<'a> {
@@ -53,6 +57,7 @@ impl<'a> PlateModel<'a> {
             // The etalon's indices do not depend on the wavelength (no dispersion): any one
             // selects where they are evaluated.
             etalon: plate.etalon(550.0, beta),
+            fixed: OnceCell::new(),
         }
     }
 
@@ -63,15 +68,23 @@ impl<'a> PlateModel<'a> {
 
     /// Exactly at `lambda_nm` (s/p frames, power fractions).
     pub fn at(&self, lambda_nm: f64, want: Want, output: Output) -> Result<SlabMueller> {
-        match &self.etalon {
-            Some(e) => Ok(e.mueller(lambda_nm, want, output)),
-            None => Ok(output.keep(
-                self.plate
-                    .at(lambda_nm)?
-                    .optics(&self.frame, self.beta)?
-                    .mueller(lambda_nm, want)?,
-            )),
+        if let Some(e) = &self.etalon {
+            return Ok(e.mueller(lambda_nm, want, output));
         }
+        let solve = || self.plate.at(lambda_nm)?.optics(&self.frame, self.beta);
+        let m = if self.plate.is_dispersive() {
+            solve()?.mueller(lambda_nm, want)?
+        } else {
+            let optics = match self.fixed.get() {
+                Some(o) => o,
+                None => {
+                    let o = solve()?;
+                    self.fixed.get_or_init(|| o)
+                }
+            };
+            optics.mueller(lambda_nm, want)?
+        };
+        Ok(output.keep(m))
     }
 
     /// Over the band `Σ_j a_j G(k; μ_j, σ_j)`. `incoherent` keeps the etalon's incoherent sum

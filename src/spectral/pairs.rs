@@ -25,7 +25,7 @@ pub struct Group {
     pub sum: [i32; 4],
     /// Its pairs: a range of [`Groups::pairs`].
     pub pairs: std::ops::Range<usize>,
-    /// `Σ weight |A_a| |A_b|` at the centre.
+    /// `Σ weight |A_a| |A_b|` at the centre, each times its least attenuation over the band.
     pub strength: f64,
     /// Its group path at the centre (nm).
     pub group_path: f64,
@@ -65,6 +65,10 @@ pub struct Selection<'a> {
     pub group: [f64; 4],
     /// An absorbing layer: pairs are also grouped by their attenuation.
     pub absorbing: bool,
+    /// The least attenuation exponent per traversal over the band
+    /// ([`crate::spectral::amplitudes::least_attenuation`]): a class's strength is its
+    /// amplitude times `e^{−counts · loss}`.
+    pub loss: [f64; 4],
     /// The rule whose visibility of a fringe of group path `G` decides ([`FringeRule::visibility`]).
     pub rule: &'a FringeRule,
     /// A group whose strength times its visibility is below this is dropped.
@@ -85,7 +89,12 @@ pub fn groups(classes: &[PathClass], s: &Selection) -> Groups {
         .enumerate()
         .map(|(i, c)| {
             let counts = c.counts.map(i32::from);
-            (c.amplitude.norm(), i, d * dot(&counts, &s.group))
+            let attenuation = (-dot(&counts, &s.loss)).exp();
+            (
+                c.amplitude.norm() * attenuation,
+                i,
+                d * dot(&counts, &s.group),
+            )
         })
         .collect();
     by_norm.sort_by(|x, y| y.0.total_cmp(&x.0));

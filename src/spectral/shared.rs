@@ -266,7 +266,7 @@ pub fn points(set: WeightSet, omega_1: f64, omega_b: f64, rho: f64) -> Option<us
     if !(omega_1.is_finite() && omega_b.is_finite() && (0.0..1.0).contains(&rho)) {
         return None;
     }
-    LADDER.iter().copied().find(|&p| {
+    let enough = |p: usize| {
         let rule = rule(set, p);
         let fits = |amplitude: f64, omega: f64| {
             amplitude * rule.error_at(SPAN_MARGIN * omega) <= TOLERANCE
@@ -285,7 +285,15 @@ pub fn points(set: WeightSet, omega_1: f64, omega_b: f64, rho: f64) -> Option<us
             }
         }
         unreachable!()
-    })
+    };
+    // More points integrate every oscillation better, so the rungs that suffice are a suffix
+    // of the ladder: bisect (a few rungs checked, each check walks the orders), and confirm.
+    let first = LADDER.partition_point(|&p| !enough(p));
+    LADDER
+        .get(first)
+        .copied()
+        .filter(|&p| enough(p))
+        .or_else(|| LADDER.iter().copied().find(|&p| enough(p)))
 }
 
 /// `∫ w_c(k) M(k) dk` for the three channels of `set` with the shared rule of `points` points
