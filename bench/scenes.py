@@ -16,7 +16,7 @@ of the machine; wall time of ``mi.render`` only, the scene loaded and rendered o
    cached in ``bench/out/reference-<scene>-<hash>.npz``, the hash over the scene's source, the
    render parameters, Mitsuba's version and the plugin library's bytes. Methods:
    (a) ``exact``: the spectral variant, ``filter_bandwidth = 0``, at increasing spp;
-   (b) ``filter``: the same with the default 4 nm band;
+   (b) ``filter``: the same with a 4 nm band (``filter_bandwidth = 4``; the default is 0);
    (c) ``rgb``: ``scalar_rgb`` (the plate integrated in closed form over the sRGB channels), if
    the scene's ``VARIANTS`` list it.
    Errors against the reference: relative RMSE in linear RGB, ``sqrt(mean((x - r)^2) - v_r) /

@@ -11,7 +11,9 @@
 //! lobes, Radiance), `plate_*` (`plate_lobes`, Radiance, both lobes: isotropic 1 mm plate
 //! exact / 4 nm band / sRGB, quartz 20 um, 60 um, calcite 1 mm and a 3 mm photoelastic-like
 //! plate in a 4 nm band, a 0.5 um lithium niobate film in sRGB: in air, and as in the thin_film
-//! scene, x-cut on black silica, `plate_film_scene_rgb`). Directions: 64 on a spiral up
+//! scene, x-cut on black silica, `plate_film_scene_rgb`; the four exact wavelengths of one path
+//! of a spectral variant through a 20 um quartz plate, `plate_quartz_4exact`, and through a 3 mm
+//! photoelastic plate, `plate_stress_4exact`). Directions: 64 on a spiral up
 //! to `THETA_MAX` degrees from the normal (default 45, the directions plugin/README.md's counts
 //! are quoted for).
 
@@ -40,6 +42,15 @@ fn dirs(n: usize) -> Vec<Vector3<f64>> {
             Vector3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos())
         })
         .collect()
+}
+
+/// The four wavelengths (nm) a spectral variant traces along one path, exact.
+fn four() -> Spectrum {
+    Spectrum::Bands {
+        wavelengths_nm: [412.0, 512.0, 612.0, 712.0],
+        count: 4,
+        fwhm_nm: 0.0,
+    }
 }
 
 fn main() {
@@ -144,6 +155,13 @@ fn main() {
                         fwhm_nm: 4.0,
                     },
                 ),
+                // What the spectral plugins ask along one path: four exact wavelengths.
+                "plate_quartz_4exact" => {
+                    (Material::named("quartz", 0.0, 0.0).unwrap(), 2e4, four())
+                }
+                "plate_stress_4exact" => {
+                    (Material::constant(c(1.5), c(1.5002)).unwrap(), 3e6, four())
+                }
                 "plate_film_scene_rgb" | "plate_film_rgb" => (
                     Material::named("linbo3", 0.0, 0.0).unwrap(),
                     500.0,

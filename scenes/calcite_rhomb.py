@@ -76,7 +76,7 @@ def walk_off_deg(n_o: float, n_e: float, tilt_deg: float) -> float:
                                   / (n_e**2 * math.cos(t) ** 2 + n_o**2 * math.sin(t) ** 2)))
 
 
-def scene(width: int = 360, height: int = 240, spp: int = 32, filter_bandwidth: float = 4.0,
+def scene(width: int = 360, height: int = 240, spp: int = 32, filter_bandwidth: float = 0.0,
           thickness: float = 1.2, axis_tilt_deg: float = 44.6, axis_azimuth_deg: float = 30.0,
           polarizer_deg: float | None = None, wavelength_nm: float | None = None) -> dict:
     """The scene as a dict for `mi.load_dict` (scalar_spectral_polarized).

@@ -20,7 +20,7 @@ VARIANTS = ("scalar_spectral_polarized",)
 
 
 def scene(width: int = 384, height: int = 128, spp: int = 16, max_thickness_um: float = 120.0,
-          crossed: bool = True, filter_bandwidth: float = 4.0) -> dict:
+          crossed: bool = True, filter_bandwidth: float = 0.0) -> dict:
     """The scene as a dict for `mi.load_dict` (call `mi.set_variant` first)."""
     ramp = np.linspace(0.0, 1.0, 512, dtype=np.float32)[None, :].repeat(4, axis=0)
     thickness = {

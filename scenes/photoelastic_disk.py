@@ -104,7 +104,7 @@ def write_data(directory: pathlib.Path = DATA) -> list[pathlib.Path]:
     return paths
 
 
-def scene(width: int = 512, height: int = 512, spp: int = 16, filter_bandwidth: float = 4.0,
+def scene(width: int = 512, height: int = 512, spp: int = 16, filter_bandwidth: float = 0.0,
           load_n: float = 500.0, diameter_mm: float = 50.0, thickness_mm: float = 6.0,
           stress_optic_per_pa: float = 8e-11, index: float = 1.585,
           wavelength_nm: float | None = None, texture_size: int = 1024,

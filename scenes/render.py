@@ -5,7 +5,7 @@
 
 A scene module (`scenes/<name>.py`) has a docstring (what it shows, the physics, the check), a
 constant `VARIANTS` (the Mitsuba variants it renders in, the first is the default) and
-`scene(width=..., height=..., spp=..., filter_bandwidth=4.0, **physics_options) -> dict` for
+`scene(width=..., height=..., spp=..., filter_bandwidth=0.0, **physics_options) -> dict` for
 `mi.load_dict` (the variant is set before it is called). `--set key=value` passes a physics
 option (the value is read as a Python literal when it is one, else as a string).
 

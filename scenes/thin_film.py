@@ -53,7 +53,7 @@ def thickness_profile(n: int = 256) -> np.ndarray:
     return np.clip(d, MIN_THICKNESS_UM / MAX_THICKNESS_UM, 1.0).astype(np.float32)
 
 
-def scene(width: int = 256, height: int = 256, spp: int = 16, filter_bandwidth: float = 4.0,
+def scene(width: int = 256, height: int = 256, spp: int = 16, filter_bandwidth: float = 0.0,
           max_thickness_um: float = MAX_THICKNESS_UM, optic_axis=(1.0, 0.0, 0.0),
           camera_angle_deg: float = 40.0, light_scale: float = 3.0,
           black_substrate: bool = True) -> dict:

@@ -77,7 +77,7 @@ def write_data(directory: pathlib.Path = DATA) -> list[pathlib.Path]:
     return paths
 
 
-def scene(width: int = 360, height: int = 240, spp: int = 32, filter_bandwidth: float = 4.0,
+def scene(width: int = 360, height: int = 240, spp: int = 32, filter_bandwidth: float = 0.0,
           polarising_filter: str = "half", incidence_deg: float = 60.0,
           reflector_ior: float = 1.333, peak_stress_mpa: float = 45.0,
           nozzle_pitch: float = 0.5, thickness_mm: float = 5.0, index: float = 1.52,

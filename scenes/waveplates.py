@@ -64,7 +64,7 @@ def plate_thickness_um(fraction_of_wave: float, wavelength_nm: float = DESIGN_WA
     return fraction_of_wave * wavelength_nm * 1e-3 / abs(n_e - n_o)
 
 
-def scene(width: int = 384, height: int = 128, spp: int = 16, filter_bandwidth: float = 4.0,
+def scene(width: int = 384, height: int = 128, spp: int = 16, filter_bandwidth: float = 0.0,
           wavelength_nm: float | None = None, polarizer_deg: float = 45.0,
           hwp_axis_deg: float = 15.0, stokes: bool = True) -> dict:
     """The scene as a dict for `mi.load_dict` (scalar_spectral_polarized).

@@ -1,6 +1,6 @@
 //! Fast complex elementary functions and small dense solves used on hot paths.
 
-use nalgebra::Matrix4;
+use nalgebra::{Matrix2, Matrix4};
 use num_complex::Complex64 as C64;
 use std::ops::{Add, Mul, Neg, Sub};
 
@@ -155,6 +155,26 @@ pub fn solve4(a: &Matrix4<C64>, b: &Matrix4<C64>) -> Option<Matrix4<C64>> {
 
 /// Uniform numbers in `[0, 1)` from a 64-bit linear congruential generator (Knuth's MMIX
 /// constants, the top 53 bits): reproducible inputs for the unit tests.
+/// `a b`, written out.
+#[inline(always)]
+pub fn mul2(a: &Matrix2<C64>, b: &Matrix2<C64>) -> Matrix2<C64> {
+    Matrix2::new(
+        a[(0, 0)] * b[(0, 0)] + a[(0, 1)] * b[(1, 0)],
+        a[(0, 0)] * b[(0, 1)] + a[(0, 1)] * b[(1, 1)],
+        a[(1, 0)] * b[(0, 0)] + a[(1, 1)] * b[(1, 0)],
+        a[(1, 0)] * b[(0, 1)] + a[(1, 1)] * b[(1, 1)],
+    )
+}
+
+/// The largest singular value of a 2x2 complex matrix: `σ² = (‖A‖²_F + √(‖A‖⁴_F − 4|det A|²))/2`
+/// (the norm of `Aⁿ` is at most its `n`-th power; the Frobenius norm would overestimate it by up
+/// to `√2ⁿ`).
+pub fn spectral_norm(a: &nalgebra::Matrix2<C64>) -> f64 {
+    let f2 = a.norm_squared();
+    let det = (a[(0, 0)] * a[(1, 1)] - a[(0, 1)] * a[(1, 0)]).norm_sqr();
+    (0.5 * (f2 + (f2 * f2 - 4.0 * det).max(0.0).sqrt())).sqrt()
+}
+
 #[cfg(test)]
 pub(crate) fn uniform(seed: u64) -> impl FnMut() -> f64 {
     let mut state = seed;
@@ -202,5 +222,19 @@ mod tests {
         let x = solve4(&a, &b).unwrap();
         assert!((a * x - b).norm() < 1e-12);
         assert!(solve4(&Matrix4::zeros(), &b).is_none());
+    }
+
+    /// Against the square root of the largest eigenvalue of `A†A`, on random matrices.
+    #[test]
+    fn spectral_norm_is_the_largest_singular_value() {
+        let mut uniform = uniform(3);
+        let mut next = || 2.0 * uniform() - 1.0;
+        for _ in 0..1000 {
+            let a = nalgebra::Matrix2::from_fn(|_, _| C64::new(next(), next()));
+            let h = a.adjoint() * a;
+            let (p, q) = ((h[(0, 0)] + h[(1, 1)]).re, (h[(0, 0)] - h[(1, 1)]).re);
+            let largest = 0.5 * (p + (q * q + 4.0 * h[(0, 1)].norm_sqr()).sqrt());
+            assert!((spectral_norm(&a) - largest.sqrt()).abs() < 1e-12 * (1.0 + largest));
+        }
     }
 }

@@ -13,7 +13,8 @@ use birefringent::plate::etalon::Etalon;
 use birefringent::plate::slab::Output;
 use birefringent::plate::slab::Want;
 use birefringent::plate::Plate;
-use birefringent::spectral::integrate::{integrate, integrate_with, Method};
+use birefringent::spectral::integrate::{integrate_with, Method};
+use birefringent::spectral::model::PlateModel;
 use birefringent::spectral::weights::{gaussians, WeightSet};
 use birefringent::C64;
 use nalgebra::{Matrix4, Vector3};
@@ -145,7 +146,11 @@ fn etalon_band_equals_the_general_band_integration() {
         if plate.etalon(550.0, beta).is_none() {
             continue;
         }
-        let fast = integrate(&plate, &frame, beta, &band, Want::BOTH, Output::Mueller).unwrap();
+        let model = PlateModel::new(&plate, frame, beta);
+        assert!(model.etalon().is_some());
+        let fast = model
+            .band(&band, Want::BOTH, Output::Mueller, &mut None)
+            .unwrap();
         let method = if thick {
             Method::Paths(None)
         } else {
@@ -222,7 +227,7 @@ fn fast_path_declines_what_it_cannot_do() {
 }
 
 /// The bulk surface of a lossless isotropic "crystal": the closed-form lobes against the general
-/// path (4x4 solve, lobes of each mode, Radiance by time reversal), every field of every lobe,
+/// path (4x4 solve, lobes of each mode, Radiance by reciprocity), every field of every lobe,
 /// both transport modes, both sides, TIR from inside included.
 #[test]
 fn isotropic_crystal_lobes_equal_the_full_computation() {

@@ -179,7 +179,7 @@ fn srgb_lobes_keep_negative_channels() {
     use birefringent::plate::slab::Output;
     use birefringent::plate::slab::Want;
     use birefringent::render::plate::{plate_lobes, PlateQuery, Spectrum};
-    use birefringent::spectral::integrate::integrate_set;
+    use birefringent::spectral::model::{Accuracy, PlateModel};
     use birefringent::spectral::weights::WeightSet;
     let q = PlateQuery::new(
         Material::named("linbo3", 0.0, 0.0).unwrap(),
@@ -200,16 +200,19 @@ fn srgb_lobes_keep_negative_channels() {
     let lobes = plate_lobes(&q, &spectrum, wi, Transport::Radiance).unwrap();
     // Radiance: the core solves the plate for light arriving from the reflected direction.
     let wo = Vector3::new(0.0, theta.sin(), theta.cos());
-    let direct = integrate_set(
+    let direct = PlateModel::new(
         &q.plate,
-        &PlaneFrame::from_direction(wo),
+        PlaneFrame::from_direction(wo),
         C64::new(theta.sin(), 0.0),
+    )
+    .channels(
         WeightSet::SrgbD65,
         Want {
             reflection: true,
             transmission: false,
         },
         Output::Intensity,
+        Accuracy::Perceptual,
     )
     .unwrap();
     let r = lobes[0][0].unwrap().weight;

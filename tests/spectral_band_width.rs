@@ -2,7 +2,7 @@
 //! `tests/common/band.rs`, independently of `birefringent::band`): through the calculator's
 //! `spectrum.bandwidth_nm` (the same band as the plugin's `filter_bandwidth`), a retarder's
 //! fringe keeps exactly the contrast exp(-sigma_k^2 D^2 / 2) of a Gaussian of that FWHM, and the
-//! contrast factors plugin/README.md quotes for the default 4 nm band are those of that
+//! contrast factors plugin/README.md quotes for a 4 nm band are those of that
 //! Gaussian (recomputed here by quadrature over a Gaussian in wavelength, a second reading of
 //! "4 nm FWHM").
 
@@ -86,8 +86,8 @@ fn contrast_of_a_gaussian_in_wavelength(center: f64, fwhm: f64, d_nm: f64) -> f6
 }
 
 #[test]
-fn contrast_factors_quoted_for_the_default_band() {
-    // plugin/README.md ("`filter_bandwidth`"): at 550 nm the default 4 nm band keeps 99.8 % of
+fn contrast_factors_quoted_for_a_4_nm_band() {
+    // plugin/README.md ("`filter_bandwidth`"): at 550 nm a 4 nm band keeps 99.8 % of
     // the contrast of a 1.7 um path difference and 98.5 % of a 5 um one.
     for (d_nm, quoted) in [(1700.0, 0.998), (5000.0, 0.985)] {
         let gaussian_k = contrast(550.0, 4.0, d_nm);

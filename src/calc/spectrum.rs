@@ -1,6 +1,8 @@
 //! `birefringence slab` with a `spectrum`: Mueller matrices integrated over camera channel
-//! weights or over a Gaussian band, in closed form ("analytic") or by dense quadrature of the
-//! exact slab ("quadrature", the reference).
+//! weights or over a Gaussian band, in closed form ("analytic": what the renderer uses, to the
+//! perceptual budget of `spectral::channels` over channels; "exact": every approximation below
+//! 1e-5 of the fitted weights) or by dense quadrature of the exact slab ("quadrature", the
+//! reference).
 
 use super::input::Fields;
 use super::output::num;
@@ -10,7 +12,8 @@ use crate::error::{Error, Result};
 use crate::params::Bandwidth;
 use crate::plate::slab::Output;
 use crate::plate::slab::{SlabMueller, Want};
-use crate::spectral::integrate::{integrate, integrate_set, quadrature};
+use crate::spectral::integrate::quadrature;
+use crate::spectral::model::{Accuracy, PlateModel};
 use crate::spectral::weights::{weight_per_nm, WeightSet};
 use nalgebra::{Matrix4, Vector4};
 use serde_json::{json, Map, Value};
@@ -28,12 +31,16 @@ pub fn run(input: &Value, fields: &[&str], spec: &Value) -> Result<Value> {
         "spectrum",
     )?;
     let method = s.string("method")?.unwrap_or("analytic");
-    if !matches!(method, "analytic" | "quadrature") {
-        return Err(Error::new(
-            "spectrum.method",
-            format!("must be \"analytic\" or \"quadrature\", got \"{method}\""),
-        ));
-    }
+    let accuracy = match method {
+        "analytic" => Accuracy::Perceptual,
+        "exact" | "quadrature" => Accuracy::Exact,
+        _ => {
+            return Err(Error::new(
+                "spectrum.method",
+                format!("must be \"analytic\", \"exact\" or \"quadrature\", got \"{method}\""),
+            ))
+        }
+    };
     let step = s.number("step_nm")?;
     if let Some(st) = step {
         if st <= 0.0 {
@@ -72,7 +79,8 @@ pub fn run(input: &Value, fields: &[&str], spec: &Value) -> Result<Value> {
                         })
                         .collect::<Result<Vec<_>>>()?
                 } else {
-                    integrate_set(&q.plate, &q.frame, q.beta, set, Want::BOTH, Output::Mueller)?
+                    PlateModel::new(&q.plate, q.frame, q.beta)
+                        .channels(set, Want::BOTH, Output::Mueller, accuracy)?
                         .to_vec()
                 };
                 (
@@ -156,13 +164,11 @@ fn band(q: &SlabQuery, b: Bandwidth, quad: bool, step: Option<f64>) -> Result<Sl
     }
     let g = narrow_band(q.wavelength_nm, b);
     if !quad {
-        return integrate(
-            &q.plate,
-            &q.frame,
-            q.beta,
+        return PlateModel::new(&q.plate, q.frame, q.beta).band(
             &[g],
             Want::BOTH,
             Output::Mueller,
+            &mut None,
         );
     }
     let weight = move |lambda: f64| {

@@ -49,12 +49,13 @@ pub fn from_jones(j: &Matrix2<C64>) -> Matrix4<f64> {
 /// like the Jones matrices do (`K(J₁J₂) = K(J₁)K(J₂)`). Sums of `K` over incoherent paths and
 /// band-integrated sums over coherent pairs of paths are still coherency superoperators.
 pub fn coherency(j: &Matrix2<C64>) -> Matrix4<C64> {
-    j.map(|z| z.conj()).kronecker(j)
+    cross(j, j)
 }
 
-/// The cross term `conj(J₁) ⊗ J₂` of two coherent contributions (`coherency(J) = cross(J, J)`).
+/// The cross term `conj(J₁) ⊗ J₂` of two coherent contributions (`coherency(J) = cross(J, J)`):
+/// entry `(2 r₁ + r₂, 2 c₁ + c₂)` is `conj(J₁[r₁][c₁]) J₂[r₂][c₂]`.
 pub fn cross(j1: &Matrix2<C64>, j2: &Matrix2<C64>) -> Matrix4<C64> {
-    j1.map(|z| z.conj()).kronecker(j2)
+    Matrix4::from_fn(|r, c| j1[(r / 2, c / 2)].conj() * j2[(r % 2, c % 2)])
 }
 
 /// The Mueller matrix of a coherency superoperator that is diagonal, `diag(ss, sp, conj(sp),
@@ -72,25 +73,60 @@ pub fn from_diagonal(ss: f64, sp: C64, pp: f64) -> Matrix4<f64> {
     )
 }
 
-/// The Mueller matrix `Re(A K A⁻¹)` of a coherency superoperator.
+/// The Mueller matrix `Re(A K A⁻¹)` of a coherency superoperator, written out: `A` has only
+/// the entries 0, ±1, ±i, so `B = K A⁻¹ = ½ K A†` takes the column combinations
+/// `(K₀ + K₃, K₀ − K₃, K₁ + K₂, i (K₂ − K₁))/2` and `A B` the row combinations
+/// `(B₀ + B₃, B₀ − B₃, B₁ + B₂, i (B₁ − B₂))` (equal to the matrix products; tested).
 pub fn from_coherency(k: &Matrix4<C64>) -> Matrix4<f64> {
-    (a_matrix() * k * a_inverse()).map(|x| x.re)
+    let i = C64::new(0.0, 1.0);
+    let b = Matrix4::from_fn(|r, j| {
+        0.5 * match j {
+            0 => k[(r, 0)] + k[(r, 3)],
+            1 => k[(r, 0)] - k[(r, 3)],
+            2 => k[(r, 1)] + k[(r, 2)],
+            _ => i * (k[(r, 2)] - k[(r, 1)]),
+        }
+    });
+    Matrix4::from_fn(|r, j| {
+        match r {
+            0 => b[(0, j)] + b[(3, j)],
+            1 => b[(0, j)] - b[(3, j)],
+            2 => b[(1, j)] + b[(2, j)],
+            _ => i * (b[(1, j)] - b[(2, j)]),
+        }
+        .re
+    })
 }
 
-/// Mitsuba's coherency → Stokes matrix `A`.
-fn a_matrix() -> Matrix4<C64> {
-    let (o, z, i) = (C64::new(1.0, 0.0), C64::new(0.0, 0.0), C64::new(0.0, 1.0));
-    Matrix4::new(o, z, z, o, o, z, z, -o, z, o, o, z, z, i, -i, z)
-}
-
-/// `A⁻¹ = ½ A†`.
-fn a_inverse() -> Matrix4<C64> {
-    a_matrix().adjoint() * C64::new(0.5, 0.0)
+/// The Mueller matrix of the reversed path, `Q Mᵀ Q` with `Q = diag(1, 1, −1, 1)`: the
+/// reciprocity theorem for media with symmetric dielectric tensors (Z. Sekera, JOSA 56, 1732,
+/// 1966), in Mitsuba's Stokes convention with each beam's frame keeping its `x` axis (the
+/// reversed beam's `y = k × x` changes sign, and with it `U`). Light from `−wo` that reaches
+/// `wi` retraces the wave that went from `−wi` to `wo`, so one forward solve gives both
+/// transport modes of a lobe.
+pub fn reversed(m: &Matrix4<f64>) -> Matrix4<f64> {
+    let mut r = m.transpose();
+    for i in 0..4 {
+        r[(i, 2)] = -r[(i, 2)];
+        r[(2, i)] = -r[(2, i)];
+    }
+    r
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Mitsuba's coherency → Stokes matrix `A`.
+    fn a_matrix() -> Matrix4<C64> {
+        let (o, z, i) = (C64::new(1.0, 0.0), C64::new(0.0, 0.0), C64::new(0.0, 1.0));
+        Matrix4::new(o, z, z, o, o, z, z, -o, z, o, o, z, z, i, -i, z)
+    }
+
+    /// `A⁻¹ = ½ A†`.
+    fn a_inverse() -> Matrix4<C64> {
+        a_matrix().adjoint() * C64::new(0.5, 0.0)
+    }
 
     /// Stokes vector (Mitsuba's definitions) of a core-convention field `(ex, ey)`.
     fn stokes(ex: C64, ey: C64) -> [f64; 4] {
@@ -125,6 +161,27 @@ mod tests {
                 assert!((got - so[r]).abs() < 1e-14, "row {r}: {got} vs {}", so[r]);
             }
         }
+    }
+
+    #[test]
+    fn written_out_coherency_algebra_equals_the_matrix_products() {
+        let j1 = Matrix2::new(
+            C64::new(0.3, -0.2),
+            C64::new(-0.1, 0.5),
+            C64::new(0.7, 0.05),
+            C64::new(-0.4, -0.6),
+        );
+        let j2 = Matrix2::new(
+            C64::new(-0.25, 0.1),
+            C64::new(0.6, -0.3),
+            C64::new(0.02, 0.9),
+            C64::new(0.5, 0.45),
+        );
+        let kron = j1.map(|z| z.conj()).kronecker(&j2);
+        assert!((cross(&j1, &j2) - kron).norm() < 1e-15);
+        let k = kron + coherency(&j2) * C64::new(0.3, -0.7);
+        let product = (a_matrix() * k * a_inverse()).map(|x| x.re);
+        assert!((from_coherency(&k) - product).norm() < 1e-14);
     }
 
     #[test]

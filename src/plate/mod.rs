@@ -12,7 +12,7 @@ use crate::material::Material;
 use crate::optics::frame::PlaneFrame;
 use crate::optics::medium::Uniaxial;
 use crate::plate::etalon::Etalon;
-use crate::plate::slab::{Output, Slab, SlabMueller, Want};
+use crate::plate::slab::Slab;
 use nalgebra::Vector3;
 use num_complex::Complex64 as C64;
 
@@ -49,6 +49,14 @@ impl Plate {
         })
     }
 
+    /// The layer's normal components `[o↓, e↓, o↑, e↑]` at `lambda_nm` for incidence parameter
+    /// `beta` in the plane of `frame` (what [`Slab::layer_q`] gives, without building the slab).
+    pub fn layer_q(&self, lambda_nm: f64, frame: &PlaneFrame, beta: C64) -> Result<[C64; 4]> {
+        let (eo, ee) = self.material.indices(lambda_nm, self.birefringence)?;
+        let layer = Uniaxial::new(eo, ee, frame.to_working(self.axis))?;
+        Ok(crate::optics::modes::normal_components(&layer, beta))
+    }
+
     /// True if any index varies with wavelength.
     pub fn is_dispersive(&self) -> bool {
         self.material.is_dispersive()
@@ -67,25 +75,5 @@ impl Plate {
             return None;
         }
         Etalon::new(self.ext, eo, self.exit, beta, self.thickness_nm)
-    }
-
-    /// The exact Mueller matrices at `lambda_nm` (s/p frames of `frame`), as `output` asks: the
-    /// isotropic fast path where it applies, else the general slab ([`Slab::optics`]).
-    pub fn mueller_at(
-        &self,
-        lambda_nm: f64,
-        frame: &PlaneFrame,
-        beta: C64,
-        want: Want,
-        output: Output,
-    ) -> Result<SlabMueller> {
-        match self.etalon(lambda_nm, beta) {
-            Some(e) => Ok(e.mueller(lambda_nm, want, output)),
-            None => Ok(output.keep(
-                self.at(lambda_nm)?
-                    .optics(frame, beta)?
-                    .mueller(lambda_nm, want)?,
-            )),
-        }
     }
 }

@@ -268,17 +268,6 @@ fn expi(z: C64) -> C64 {
     }
 }
 
-/// `a b`, written out.
-#[inline(always)]
-fn mul(a: &Matrix2<C64>, b: &Matrix2<C64>) -> Matrix2<C64> {
-    Matrix2::new(
-        a[(0, 0)] * b[(0, 0)] + a[(0, 1)] * b[(1, 0)],
-        a[(0, 0)] * b[(0, 1)] + a[(0, 1)] * b[(1, 1)],
-        a[(1, 0)] * b[(0, 0)] + a[(1, 1)] * b[(1, 0)],
-        a[(1, 0)] * b[(0, 1)] + a[(1, 1)] * b[(1, 1)],
-    )
-}
-
 /// `diag(a) m`.
 #[inline]
 fn scale_rows(a: &[C64; 2], m: &Matrix2<C64>) -> Matrix2<C64> {
@@ -336,20 +325,20 @@ impl SlabBlocks {
         let (pd, pu) = phase_factors(self.thickness_nm, lambda_nm, &self.q);
         // P↑ r₂ P↓, shared by the round trip D and the reflected paths.
         let trip = scale(&pu, &self.r2, &pd);
-        let d = mul(&self.r3, &trip);
+        let d = cmath::mul2(&self.r3, &trip);
         let inverse = inverse(&(Matrix2::identity() - d)).ok_or_else(|| {
             Error::new(
                 "slab",
                 "internal resonance: the multiple-reflection sum diverges",
             )
         })?;
-        let inner = mul(&inverse, &self.t1);
+        let inner = cmath::mul2(&inverse, &self.t1);
         let r = want
             .reflection
-            .then(|| self.r1 + mul(&self.t3, &mul(&trip, &inner)));
+            .then(|| self.r1 + cmath::mul2(&self.t3, &cmath::mul2(&trip, &inner)));
         let t = want.transmission.then(|| {
             let f = self.flux.sqrt();
-            mul(&self.t2, &scale_rows(&[pd[0] * f, pd[1] * f], &inner))
+            cmath::mul2(&self.t2, &scale_rows(&[pd[0] * f, pd[1] * f], &inner))
         });
         Ok(SlabJones { r, t })
     }

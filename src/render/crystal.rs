@@ -17,6 +17,7 @@
 use crate::error::{Error, Result};
 use crate::optics::lobes::{scatter, Event, Lobe};
 use crate::optics::modes::ModeKind;
+use crate::optics::mueller::reversed;
 use crate::optics::surface::{Incident, Surface};
 use crate::render::isotropic;
 use crate::render::{PathLobe, Transport};
@@ -43,21 +44,17 @@ fn forward_events(
 }
 
 /// The outgoing lobes of an event whose incident crystal mode is `incident` (`None`: from
-/// the exterior): `(component, crystal mode of the outgoing wave or None if exterior, lobe)`.
-/// Reflections are component 0; a transmission is 1 or 2 by its crystal-side mode.
-fn outgoing(event: &Event, incident: Option<ModeKind>) -> Vec<(usize, Option<ModeKind>, Lobe)> {
+/// the exterior), with their components: reflections are 0; a transmission is 1 or 2 by its
+/// crystal-side mode.
+fn outgoing(event: &Event, incident: Option<ModeKind>) -> impl Iterator<Item = (usize, Lobe)> + '_ {
     let by_mode = |m: ModeKind| if m == ModeKind::E { 2 } else { 1 };
-    let mut v = Vec::new();
-    for l in event.reflected.iter().flatten() {
-        v.push((0, incident.map(|_| l.kind), *l));
-    }
-    for l in event.transmitted.iter().flatten() {
-        match incident {
-            None => v.push((by_mode(l.kind), Some(l.kind), *l)),
-            Some(m) => v.push((by_mode(m), None, *l)),
-        }
-    }
-    v
+    let reflected = event.reflected.iter().flatten().map(|l| (0, *l));
+    let transmitted = event
+        .transmitted
+        .iter()
+        .flatten()
+        .map(move |l| (by_mode(incident.unwrap_or(l.kind)), *l));
+    reflected.chain(transmitted)
 }
 
 /// Lobes of a bulk crystal surface seen from `wi` (unit, local; `wi.z < 0` is inside). A
@@ -114,7 +111,7 @@ pub fn crystal_lobes_full(
     }
     let mut lobes = Vec::new();
     for (inc, event) in forward_events(surface, wi)? {
-        for (component, mode, l) in outgoing(&event, inc) {
+        for (component, l) in outgoing(&event, inc) {
             if opaque && component != 0 {
                 continue; // refracted into the opaque bulk: absorbed at the surface
             }
@@ -126,11 +123,13 @@ pub fn crystal_lobes_full(
                     l.mueller,
                     l.ray_index / event.incident_ray_index,
                 )),
-                Transport::Radiance => {
-                    if let Some(p) = radiance_lobe(surface, wi, inc, l.direction, mode)? {
-                        lobes.push(p);
-                    }
-                }
+                Transport::Radiance => lobes.push(PathLobe::new(
+                    component,
+                    l.direction,
+                    (l.stokes_x, event.incident_stokes_x),
+                    reversed(&l.mueller) * (event.incident_ray_index / l.ray_index).powi(2),
+                    l.ray_index / event.incident_ray_index,
+                )),
             }
         }
     }
@@ -141,42 +140,4 @@ pub fn crystal_lobes_full(
 /// at the surface and none arrives from inside (see the module documentation).
 pub fn opaque(surface: &Surface) -> bool {
     !surface.crystal.is_lossless()
-}
-
-/// The physical transfer from the source at `wo` (found by time reversal) into the wave that
-/// leaves along `wi` in mode `wi_mode` (`None` outside the crystal).
-fn radiance_lobe(
-    surface: &Surface,
-    wi: Vector3<f64>,
-    wi_mode: Option<ModeKind>,
-    wo: Vector3<f64>,
-    wo_mode: Option<ModeKind>,
-) -> Result<Option<PathLobe>> {
-    let incident = match wo_mode {
-        None => Incident::Outside,
-        Some(_) if surface.crystal.is_isotropic() => Incident::Inside(ModeKind::O),
-        Some(m) => Incident::Inside(m),
-    };
-    let event = match scatter(surface, wo, incident) {
-        Ok(e) => e,
-        Err(_) => return Ok(None), // grazing source: carries no power
-    };
-    let source = match incident {
-        Incident::Inside(k) => Some(k),
-        Incident::Outside => None,
-    };
-    let iso = surface.crystal.is_isotropic();
-    let found = outgoing(&event, source)
-        .into_iter()
-        .find(|(_, mode, l)| (l.direction - wi).norm() < 1e-6 && (iso || *mode == wi_mode));
-    Ok(found.map(|(component, _, l)| {
-        let scale = (l.ray_index / event.incident_ray_index).powi(2);
-        PathLobe::new(
-            component,
-            wo,
-            (event.incident_stokes_x, l.stokes_x),
-            l.mueller * scale,
-            event.incident_ray_index / l.ray_index,
-        )
-    }))
 }

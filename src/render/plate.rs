@@ -2,19 +2,19 @@
 //! them, over one wavelength, a band or a set of colour channels (see [`crate::render`] for the
 //! transport modes).
 
-use crate::band::Gaussian;
 use crate::band::{is_exact_band, narrow_band};
 use crate::error::{Error, Result};
 use crate::material::check_clear_index;
 use crate::material::{check_wavelength, Material};
 use crate::optics::frame::PlaneFrame;
 use crate::optics::medium::Uniaxial;
+use crate::optics::mueller::reversed;
 use crate::params::{Bandwidth, Thickness};
 use crate::plate::slab::{Output, SlabMueller, Want};
 use crate::plate::Plate;
 use crate::render::{PathLobe, Transport};
-use crate::spectral::integrate::{etalon_sum, integrate, integrate_set};
-use crate::spectral::weights::{gaussians, WeightSet};
+use crate::spectral::model::{Accuracy, PlateModel};
+use crate::spectral::weights::WeightSet;
 use nalgebra::{Matrix4, Vector3};
 use num_complex::Complex64 as C64;
 
@@ -166,8 +166,10 @@ impl PlateQuery {
 }
 
 /// The plate's lobes seen from `wi`, one `[reflection, transmission]` pair per spectral
-/// channel (one for [`Spectrum::Band`]). An isotropic plate ([`Plate::etalon`]) is solved once
-/// for both lobes (by reciprocity; `isotropic_plate` in this module).
+/// channel (one for [`Spectrum::Band`]). The plate is solved once, from `wi`'s side, for both
+/// lobes: in Importance mode that is each lobe's own incidence; in Radiance mode (light from
+/// the mirror direction, or from the far side) each lobe is the reversed path of the forward
+/// one ([`reversed`], the reciprocity of media with symmetric dielectric tensors).
 pub fn plate_lobes(
     q: &PlateQuery,
     spectrum: &Spectrum,
@@ -177,8 +179,8 @@ pub fn plate_lobes(
     lobes_of_plate(q, spectrum, wi, transport, true)
 }
 
-/// [`plate_lobes`] with each lobe solved on its own (the light's own side and direction): the
-/// reference the shared isotropic solution is tested against.
+/// [`plate_lobes`] with each lobe solved on its own (the light's own side and direction, by
+/// time reversal in Radiance mode): the reference the shared solution is tested against.
 pub fn plate_lobes_full(
     q: &PlateQuery,
     spectrum: &Spectrum,
@@ -209,22 +211,21 @@ fn lobes_of_plate(
     let q = &q;
     let wi = wi.normalize();
     let reflected = Vector3::new(-wi.x, -wi.y, wi.z);
-    let through = through_plate(q, wi);
+    let lobes = [
+        Some(reflected).filter(|_| q.want.reflection),
+        through_plate(q, wi).filter(|_| q.want.transmission),
+    ];
     let shared = if share {
-        isotropic_plate(q, spectrum, wi)?
+        let want = Want {
+            reflection: lobes[0].is_some(),
+            transmission: lobes[1].is_some(),
+        };
+        Some(physical_plate(q, spectrum, wi, want)?)
     } else {
         None
     };
-    let lobes = [(0, Some(reflected)), (1, through)];
-    for (component, wo) in lobes {
-        let wanted = if component == 0 {
-            q.want.reflection
-        } else {
-            q.want.transmission
-        };
-        let Some(wo) = wo.filter(|_| wanted) else {
-            continue;
-        };
+    for (component, wo) in lobes.into_iter().enumerate() {
+        let Some(wo) = wo else { continue };
         let towards = match transport {
             Transport::Importance => wi,
             Transport::Radiance => wo,
@@ -233,12 +234,13 @@ fn lobes_of_plate(
             reflection: component == 0,
             transmission: component == 1,
         };
+        // Shared: solved from wi's side; a Radiance lobe is its reversed path.
         let own;
-        let ms: &[SlabMueller] = match &shared {
-            Some(ms) => ms,
+        let (ms, reverse): (&[SlabMueller], bool) = match &shared {
+            Some(ms) => (ms, transport == Transport::Radiance),
             None => {
                 own = physical_plate(q, spectrum, towards, want)?;
-                &own
+                (&own, false)
             }
         };
         let (n_in, n_out) = side_indices(q, towards, component);
@@ -250,7 +252,7 @@ fn lobes_of_plate(
         for (c, m) in ms.iter().enumerate() {
             let m = if component == 0 { m.r } else { m.t };
             let Some(m) = m else { continue };
-            let mut mueller = m * scale;
+            let mut mueller = if reverse { reversed(&m) } else { m } * scale;
             // A band-averaged coherency of a plate that passes (almost) nothing can give M00 a
             // rounding-level negative (seen: -2e-22); under a non-negative weight the
             // unpolarised throughput is >= 0. (A signed sRGB channel keeps its sign.)
@@ -294,14 +296,9 @@ fn through_plate(q: &PlateQuery, w: Vector3<f64>) -> Option<Vector3<f64>> {
     ))
 }
 
-/// Mueller matrices (s/p frames) of light arriving from `towards` (either side), per channel,
-/// with the incidence parameter used.
-fn physical_plate(
-    q: &PlateQuery,
-    spectrum: &Spectrum,
-    towards: Vector3<f64>,
-    want: Want,
-) -> Result<Vec<SlabMueller>> {
+/// The plate seen from `towards` (either side), mirrored through `z = 0` when it is below, and
+/// its model for that incidence (the one decision of [`PlateModel::new`]).
+fn model_from(q: &PlateQuery, towards: Vector3<f64>) -> (PlateQuery, PlaneFrame, C64, bool) {
     let (q, w, mirrored) = if towards.z > 0.0 {
         (*q, towards, false)
     } else {
@@ -311,26 +308,55 @@ fn physical_plate(
             true,
         )
     };
-    let frame = PlaneFrame::from_direction(w);
     let beta = q.plate.ext * (w.x * w.x + w.y * w.y).sqrt();
-    let one = |band: &[Gaussian]| integrate(&q.plate, &frame, beta, band, want, q.output);
-    let ms: Vec<SlabMueller> = match *spectrum {
-        Spectrum::Weights(set) => {
-            integrate_set(&q.plate, &frame, beta, set, want, q.output)?.to_vec()
+    (q, PlaneFrame::from_direction(w), beta, mirrored)
+}
+
+/// The plate's Mueller matrices (s/p frames) over `spectrum`, per channel, through `model`.
+fn evaluate(
+    model: &PlateModel,
+    spectrum: &Spectrum,
+    want: Want,
+    output: Output,
+) -> Result<Vec<SlabMueller>> {
+    match *spectrum {
+        Spectrum::Weights(set) => Ok(model
+            .channels(set, want, output, Accuracy::Perceptual)?
+            .to_vec()),
+        _ => {
+            // Bands thicker than the coherence length of an isotropic plate share one
+            // incoherent sum.
+            let mut incoherent = None;
+            spectrum
+                .bands()
+                .into_iter()
+                .map(|(wavelength_nm, fwhm_nm)| {
+                    if is_exact_band(fwhm_nm, wavelength_nm) {
+                        model.at(wavelength_nm, want, output)
+                    } else {
+                        let band = [narrow_band(wavelength_nm, fwhm_nm)];
+                        model.band(&band, want, output, &mut incoherent)
+                    }
+                })
+                .collect()
         }
-        _ => spectrum
-            .bands()
-            .into_iter()
-            .map(|(wavelength_nm, fwhm_nm)| {
-                if is_exact_band(fwhm_nm, wavelength_nm) {
-                    q.plate
-                        .mueller_at(wavelength_nm, &frame, beta, want, q.output)
-                } else {
-                    one(&[narrow_band(wavelength_nm, fwhm_nm)])
-                }
-            })
-            .collect::<Result<_>>()?,
-    };
+    }
+}
+
+/// Mueller matrices (s/p frames) of light arriving from `towards` (either side), per channel.
+fn physical_plate(
+    q: &PlateQuery,
+    spectrum: &Spectrum,
+    towards: Vector3<f64>,
+    want: Want,
+) -> Result<Vec<SlabMueller>> {
+    let (q, frame, beta, mirrored) = model_from(q, towards);
+    let ms = evaluate(
+        &PlateModel::new(&q.plate, frame, beta),
+        spectrum,
+        want,
+        q.output,
+    )?;
     let d = Matrix4::from_diagonal(&nalgebra::Vector4::new(1.0, 1.0, -1.0, -1.0));
     let fix = |m: Option<Matrix4<f64>>| m.map(|m| if mirrored { d * m * d } else { m });
     Ok(ms
@@ -340,74 +366,4 @@ fn physical_plate(
             t: fix(m.t),
         })
         .collect())
-}
-
-/// The isotropic fast path of [`plate_lobes`]: a plate for which [`Plate::etalon`] applies is
-/// solved once, from `wi`'s side, for both lobes. Reflection in Radiance mode (light from the
-/// mirror direction) sees the same incidence; transmission in Radiance mode (light from the far
-/// side) has the same Mueller matrix by reciprocity: the flux-normalised amplitudes of a
-/// lossless isotropic plate are equal both ways (`τ(1→3) = τ(3→1)`, checked against per-lobe
-/// solutions in `tests/isotropic_fast_path.rs`), and its Mueller matrices are diagonal-block,
-/// unchanged by the mirroring of a plate seen from below. `None` where the fast path does not
-/// apply.
-fn isotropic_plate(
-    q: &PlateQuery,
-    spectrum: &Spectrum,
-    wi: Vector3<f64>,
-) -> Result<Option<Vec<SlabMueller>>> {
-    let (q, w) = if wi.z > 0.0 {
-        (*q, wi)
-    } else {
-        (q.flipped(), Vector3::new(wi.x, wi.y, -wi.z))
-    };
-    let beta = q.plate.ext * (w.x * w.x + w.y * w.y).sqrt();
-    let Some(etalon) = q.plate.etalon(550.0, beta) else {
-        return Ok(None);
-    };
-    Ok(match *spectrum {
-        Spectrum::Band { .. } | Spectrum::Bands { .. } => {
-            // One etalon for every wavelength (constant indices); a band thicker than its
-            // coherence length gives the same incoherent sum at every wavelength.
-            let mut incoherent = None;
-            let mut ms = Vec::new();
-            for (wavelength_nm, fwhm_nm) in spectrum.bands() {
-                let m = if is_exact_band(fwhm_nm, wavelength_nm) {
-                    etalon.mueller(wavelength_nm, q.want, q.output)
-                } else {
-                    let g = narrow_band(wavelength_nm, fwhm_nm);
-                    match (etalon.is_incoherent(&g), incoherent) {
-                        (true, Some(m)) => m,
-                        (true, None) => {
-                            *incoherent.insert(match etalon.band(&g, q.want, q.output) {
-                                Some(m) => m,
-                                None => return Ok(None),
-                            })
-                        }
-                        (false, _) => match etalon.band(&g, q.want, q.output) {
-                            Some(m) => m,
-                            None => return Ok(None),
-                        },
-                    }
-                };
-                ms.push(m);
-            }
-            Some(ms)
-        }
-        Spectrum::Weights(set) => {
-            let mut incoherent = None;
-            let mut one = |c: usize| {
-                etalon_sum(
-                    &etalon,
-                    gaussians(set, c),
-                    q.want,
-                    q.output,
-                    &mut incoherent,
-                )
-            };
-            match (one(0), one(1), one(2)) {
-                (Some(a), Some(b), Some(c)) => Some(vec![a, b, c]),
-                _ => None,
-            }
-        }
-    })
 }

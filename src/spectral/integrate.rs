@@ -104,11 +104,6 @@ pub fn integrate_with(
     if band.is_empty() {
         return Err(Error::new("spectrum", "empty spectral band"));
     }
-    if method == Method::Auto {
-        if let Some(m) = etalon_band(plate, beta, band, want, output) {
-            return Ok(m);
-        }
-    }
     let mut r = Matrix4::zeros();
     let mut t = Matrix4::zeros();
     // Without dispersion the interfaces do not depend on the wavelength: solve them once.
@@ -188,19 +183,6 @@ pub fn integrate_with(
         r: want.reflection.then_some(r),
         t: want.transmission.then_some(t),
     }))
-}
-
-/// The isotropic fast path over a band ([`Etalon::band`], exact for Gaussians), where it
-/// applies to every Gaussian of the band.
-fn etalon_band(
-    plate: &Plate,
-    beta: C64,
-    band: &[Gaussian],
-    want: Want,
-    output: Output,
-) -> Option<SlabMueller> {
-    let etalon = plate.etalon(std::f64::consts::TAU / band[0].mu, beta)?;
-    etalon_sum(&etalon, band, want, output, &mut None)
 }
 
 /// `Σ_j a_j` × the etalon over Gaussian `j` (`None` if a series is too long). Thick plates
@@ -359,14 +341,14 @@ fn quadrature_rule(
     Ok((r, t))
 }
 
-/// Integrates over the three channels of a weight set at once (see [`integrate`]).
-///
-/// A lossless isotropic plate takes its closed form per Gaussian. Otherwise, when the plate's
-/// spectrum varies slowly over the whole visible range (thin plates: few oscillations of its
-/// significant orders across the weights' support), one product-integration rule of the exact plate
-/// serves every Gaussian of every channel ([`shared`]: at most 1024 plate evaluations instead
-/// of a quadrature per Gaussian). Otherwise each channel goes through [`integrate`].
-pub fn integrate_set(
+/// Integrates a plate that is not an etalon ([`crate::spectral::model`] decides) over the three
+/// channels of a weight set at once, every approximation below 1e-5 of the fitted weights:
+/// when the plate's spectrum varies slowly over the whole visible range (thin plates: few
+/// oscillations of its significant orders across the weights' support), one product-integration
+/// rule of the exact plate serves every Gaussian of every channel ([`shared`]: at most 1024
+/// plate evaluations instead of a quadrature per Gaussian); otherwise each channel goes through
+/// [`integrate`].
+pub fn integrate_set_exact(
     plate: &Plate,
     frame: &PlaneFrame,
     beta: C64,
@@ -374,19 +356,10 @@ pub fn integrate_set(
     want: Want,
     output: Output,
 ) -> Result<[SlabMueller; 3]> {
-    let bands: [&[Gaussian]; 3] = std::array::from_fn(|c| gaussians(set, c));
-    if let Some(e) = plate.etalon(std::f64::consts::TAU / bands[1][0].mu, beta) {
-        // The isotropic fast path: a closed form per Gaussian, cheaper than any shared rule.
-        let mut incoherent = None;
-        let mut one = |c: usize| etalon_sum(&e, bands[c], want, output, &mut incoherent);
-        if let (Some(a), Some(b), Some(c)) = (one(0), one(1), one(2)) {
-            return Ok([a, b, c]);
-        }
-    }
     match shared::plan(plate, frame, beta, set)? {
         Some(points) => shared::quadrature(plate, frame, beta, set, points, want, output),
         None => {
-            let one = |c: usize| integrate(plate, frame, beta, bands[c], want, output);
+            let one = |c: usize| integrate(plate, frame, beta, gaussians(set, c), want, output);
             Ok([one(0)?, one(1)?, one(2)?])
         }
     }

@@ -84,15 +84,17 @@ def test_flags_and_components():
 # ---- isotropic thick plate vs thindielectric -----------------------------------------------
 
 THICK = dict(eta_o=1.5, eta_e=1.5, ext_ior=1.0, thickness=1000.0)  # 1 mm
+# With a 4 nm band in the spectral variants (the default, 0, is the exact coherent plate).
+THICK_BAND = dict(THICK, filter_bandwidth=4.0)
 
 
 @pytest.mark.parametrize("name", ["scalar_rgb", "scalar_spectral", POLARIZED])
 def test_thick_isotropic_plate_equals_thindielectric_at_normal_incidence(name):
-    """A 1 mm isotropic plate with the default filter (spectral) or the RGB channel integration:
-    the multiple-reflection fringes (optical path 3 mm) average out, and M00 of R and T equals
+    """A 1 mm isotropic plate with a 4 nm band (spectral) or the RGB channel integration: the
+    multiple-reflection fringes (optical path 3 mm) average out, and M00 of R and T equals
     thindielectric's incoherent sum r' = 2r/(1+r)."""
     variant(name)
-    ours = plate(**THICK)
+    ours = plate(**THICK_BAND)
     theirs = mi.load_dict({"type": "thindielectric", "int_ior": 1.5, "ext_ior": 1.0})
     for side in (1, -1):
         si = surface_interaction(direction(0, 0, side))
@@ -125,9 +127,10 @@ def test_thick_isotropic_plate_exact_average_equals_thindielectric():
 def test_thick_isotropic_plate_off_normal():
     """Off normal incidence the plate sums the internal reflections per polarisation,
     R = (2 R_s / (1 + R_s) + 2 R_p / (1 + R_p)) / 2, while thindielectric averages R_s and R_p
-    first. Checks the former and reports the difference to thindielectric."""
+    first (a 4 nm band averages the fringes). Checks the former and reports the difference to
+    thindielectric."""
     variant("scalar_spectral")
-    ours = plate(**THICK)
+    ours = plate(**THICK_BAND)
     theirs = mi.load_dict({"type": "thindielectric", "int_ior": 1.5, "ext_ior": 1.0})
     report = []
     for theta in (20, 40, 60, 75, 85):
@@ -263,12 +266,16 @@ def test_energy_of_a_clear_plate_exact(name):
 
 @pytest.mark.parametrize("name", ["scalar_rgb", "scalar_spectral"])
 def test_energy_of_a_clear_plate_band_integrated(name):
-    """The same with the default 4 nm band (spectral) and the RGB channel integration, up to 60
-    degrees (few directions: band-integrated core queries are the slow ones)."""
+    """The same with a 4 nm band (spectral) and the RGB channel integration, up to 60 degrees
+    (few directions: band-integrated core queries are the slow ones)."""
     variant(name)
-    p = plate(material="calcite", thickness=7.0, optic_axis=[0.3, 0.5, 0.81])
-    # Measured 3.0e-8 in both variants: float32 rounding, as for the exact plate.
-    assert max_energy_error(p, n=12, min_abs_cos=0.5) <= 1e-7
+    p = plate(material="calcite", thickness=7.0, optic_axis=[0.3, 0.5, 0.81], filter_bandwidth=4.0)
+    # The band: measured 3.0e-8, float32 rounding, as for the exact plate. The RGB channels are
+    # integrated to a perceptual budget (src/spectral/channels.rs: each approximation held to
+    # 1e-5 of the light; a few add up in R + T): measured 2.3e-5, bound 1e-4 (a CIEDE2000 below
+    # 0.1 on a bright plate).
+    bound = 1e-4 if name == "scalar_rgb" else 1e-7
+    assert max_energy_error(p, n=12, min_abs_cos=0.5) <= bound
 
 
 # Near grazing incidence many internal reflections interfere: an isotropic 0.3 um plate (eta 1.5

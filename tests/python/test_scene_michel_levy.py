@@ -44,7 +44,7 @@ import michel_levy  # noqa: E402
 W, H, SPP = 48, 4, 64
 MAX_THICKNESS_NM = 120e3  # the scene's default max_thickness_um, stated here independently
 AIR = 1.000277  # Mitsuba's "air", the plugin's default ext_ior
-FWHM = 4.0  # the scene's default filter_bandwidth
+FWHM = 4.0  # the band this test renders the scene with (filter_bandwidth)
 # Wavelength grid step (nm). The Airy fringes of the thickest column have a period of
 # lambda^2 / (2 n d) >= 0.7 nm; against weights smoothed by the band the sum over them converges
 # fast: a step of 0.02 nm changes the prediction by 1.2e-7.
@@ -111,7 +111,7 @@ def predicted(weights, lam, crossed, retardance_scale=1.0, sub=8):
 
 def render(crossed: bool) -> np.ndarray:
     mi.set_variant("scalar_spectral_polarized")
-    scene = mi.load_dict(michel_levy.scene(width=W, height=H, spp=SPP, crossed=crossed))
+    scene = mi.load_dict(michel_levy.scene(width=W, height=H, spp=SPP, crossed=crossed, filter_bandwidth=FWHM))
     return np.array(mi.render(scene, seed=1))[..., :3].mean(axis=0)  # per column, RGB
 
 
