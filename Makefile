@@ -54,32 +54,15 @@ PYTESTS := tests/python
 
 PIP_FLAGS := --disable-pip-version-check --no-input --progress-bar off
 
-# The Mitsuba plugin library: the C++ shim (cpp/src/*.cpp) + the Rust core's static library,
-# compiled against the headers of the mitsuba/drjit/nanobind wheels in SITE, written into the
-# Python package plugin/mitsuba_birefringent/. The Python build backend
+# The Mitsuba plugin library: the crate cpp/ (the C++ shim, compiled by cpp/build.rs against the
+# headers of the mitsuba/drjit/nanobind wheels in SITE with the wheel-matching flags, linked with
+# the core), copied into the Python package plugin/mitsuba_birefringent/. The Python build backend
 # (build_backend/birefringent_backend.py, BUILD_COMMAND) builds it with `make plugin-lib`, passing
-# the site-packages of its build environment as SITE (.venv/'s for make setup), VENV_STAMP= (no
-# virtualenv is needed) and CPP_OBJ_DIR=target/cpp/<versions of the headers' packages>.
-RUST_LIB := target/release/libbirefringent.a
-CPP_OBJ_DIR := target/cpp
-CPP_SRCS := $(wildcard cpp/src/*.cpp)
-CPP_OBJS := $(patsubst cpp/src/%.cpp,$(CPP_OBJ_DIR)/%.o,$(CPP_SRCS))
-CPP_HDRS := $(wildcard cpp/src/*.h) cpp/include/birefringent.h
+# the site-packages of its build environment as SITE (.venv/'s for make setup).
 PLUGIN_SO := plugin/mitsuba_birefringent/libmitsuba_birefringent.so
+PLUGIN_BUILT := target/release/libmitsuba_birefringent.so
 # site-packages of .venv/ (evaluated when used: the venv may not exist yet when make starts)
 SITE = $(shell $(VPY) -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')
-# These flags must match the PyPI wheels (see docs/building.md): above all -march=ivybridge,
-# which sets Dr.Jit's array padding and so the layout of Mitsuba's structs. The RUNPATH finds
-# libmitsuba and libdrjit-core beside the package in site-packages (the wheel's layout).
-MI_CXXFLAGS = -std=c++17 -O2 -fPIC -fvisibility=hidden -march=ivybridge -ffp-contract=fast \
-  -fno-math-errno -DNDEBUG -DMI_ENABLE_LLVM=1 -DMI_ENABLE_CUDA=1 -DMI_ENABLE_EMBREE=1 \
-  -DMI_ENABLE_AUTODIFF=1 -Wall -Icpp/include -isystem $(SITE)/mitsuba/include \
-  -isystem $(SITE)/drjit/include -isystem $(SITE)/nanobind/include \
-  -isystem $(SITE)/nanobind/ext/robin_map/include
-MI_LDFLAGS = -shared -L$(SITE)/mitsuba -lmitsuba -L$(SITE)/drjit -ldrjit-core \
-  -Wl,-rpath,'$$ORIGIN/../mitsuba' -Wl,-rpath,'$$ORIGIN/../drjit' \
-  -Wl,--exclude-libs,ALL -Wl,--gc-sections -Wl,--strip-debug -Wl,--no-undefined \
-  -lpthread -ldl -lm
 
 .PHONY: help setup build venv plugin plugin-lib render gallery test test-rust test-python fuzz fuzz-ci bench bench-scenes fmt lint clean distclean
 
@@ -124,19 +107,11 @@ $(EDITABLE_STAMP): pyproject.toml Cargo.toml build_backend/birefringent_backend.
 	@touch $@
 
 # The library alone, against the packages in SITE (the build backend's command; see above).
+# cargo rebuilds it only when its sources (or the wheels) change; it is copied only when it
+# differs.
 plugin-lib:
-	$(CARGO) build --release --lib
-	@$(MAKE) --no-print-directory $(PLUGIN_SO)
-
-$(CPP_OBJ_DIR)/%.o: cpp/src/%.cpp $(CPP_HDRS) $(VENV_STAMP)
-	@mkdir -p $(@D)
-	$(CXX) $(MI_CXXFLAGS) -c $< -o $@
-
-$(PLUGIN_SO): $(CPP_OBJS) $(RUST_LIB)
-	$(CXX) -o $@ $(CPP_OBJS) $(RUST_LIB) $(MI_LDFLAGS)
-
-$(RUST_LIB):
-	$(CARGO) build --release --lib
+	MITSUBA_SITE_PACKAGES=$(SITE) $(CARGO) build --release -p mitsuba-birefringent-plugin
+	@cmp -s $(PLUGIN_BUILT) $(PLUGIN_SO) || { cp $(PLUGIN_BUILT) $(PLUGIN_SO); echo "updated $(PLUGIN_SO)"; }
 
 ## ---- main job ---------------------------------------------------------------------------
 

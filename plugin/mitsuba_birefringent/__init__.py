@@ -40,9 +40,6 @@ except importlib.metadata.PackageNotFoundError:
 #: The BSDF plugin names this package registers.
 PLUGINS = ("thinbirefringent", "birefringent")
 
-#: The Mitsuba variants the plugins work in.
-VARIANTS = ("scalar_rgb", "scalar_spectral", "scalar_spectral_polarized")
-
 _LIBRARY_NAME = "libmitsuba_birefringent.so"
 _lib = None
 
@@ -68,8 +65,9 @@ def _load() -> ctypes.CDLL:
         lib = ctypes.CDLL(str(path), mode=ctypes.RTLD_GLOBAL)
         lib.bfr_mitsuba_register.argtypes = [ctypes.c_char_p, ctypes.c_size_t]
         lib.bfr_mitsuba_register.restype = ctypes.c_int
-        lib.bfr_mitsuba_version.argtypes = []
-        lib.bfr_mitsuba_version.restype = ctypes.c_char_p
+        for name in ("bfr_mitsuba_version", "bfr_mitsuba_variants"):
+            getattr(lib, name).argtypes = []
+            getattr(lib, name).restype = ctypes.c_char_p
         _lib = lib
     return _lib
 
@@ -89,3 +87,6 @@ def core_version() -> str:
 
 
 register()
+
+#: The Mitsuba variants the plugins work in (as the plugin library registers them).
+VARIANTS = tuple(_load().bfr_mitsuba_variants().decode().split(", "))

@@ -90,7 +90,7 @@ def test_colour_bitmap_is_refused_at_load_in_spectral_variants(name):
 # Messages name the parameter the user wrote, in the user's unit (not the core's name, unit or
 # the Mitsuba type it was read as).
 EXACT_MESSAGES = [
-    ({"axis_angle": math.nan}, "axis_angle: must be a finite number (degrees), got nan", "optic_axis"),
+    ({"axis_angle": math.nan}, "axis_angle: must be a finite number (degrees), got NaN", "optic_axis"),
     ({"ext_ior": {"type": "rgb", "value": [1.5, 1.5, 1.5]}},
      '"ext_ior" must be a float (a real index) or one of Mitsuba\'s IOR names', "expected string"),
     ({"exit_ior": [1.0, 2.0, 3.0]},
