@@ -8,9 +8,10 @@
 #                 out/gallery/ and the contact sheet scenes/gallery.png (several minutes)
 #   make test     builds everything (make setup), then runs every test: cargo fmt --check, cargo
 #                 clippy (warnings are errors), cargo's tests, then pytest's, then make fuzz-ci
-#   make setup    cargo build --release, the virtualenv .venv/ from requirements.txt, the
-#                 Mitsuba plugin library (cpp/) and the mitsuba_birefringent package in .venv/;
-#                 idempotent, and quick when nothing changed
+#   make setup    cargo build --release, the virtualenv .venv/ from requirements.txt, Debian's
+#                 libllvm19 if missing (for Mitsuba's llvm_ad_* variants), the Mitsuba plugin
+#                 library (cpp/) and the mitsuba_birefringent package in .venv/; idempotent,
+#                 and quick when nothing changed
 #   make plugin   (part of setup) the plugin library plugin/mitsuba_birefringent/*.so and the
 #                 package in .venv/ (an editable install: `pip install -e .`, the same build as
 #                 `pip install .` and `pip wheel .`, see pyproject.toml), with its command
@@ -64,14 +65,14 @@ PLUGIN_BUILT := target/release/libmitsuba_birefringent.so
 # site-packages of .venv/ (evaluated when used: the venv may not exist yet when make starts)
 SITE = $(shell $(VPY) -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')
 
-.PHONY: help setup build venv plugin plugin-lib render gallery test test-rust test-python fuzz fuzz-ci bench bench-scenes fmt lint clean distclean
+.PHONY: help setup build venv llvm plugin plugin-lib render gallery test test-rust test-python fuzz fuzz-ci bench bench-scenes fmt lint clean distclean
 
 help:
 	@sed -n '3,/^$$/s/^# \{0,1\}//p' $(firstword $(MAKEFILE_LIST))
 
 ## ---- set-up -------------------------------------------------------------------------------
 
-setup: build venv plugin
+setup: build venv llvm plugin
 
 # Always asks cargo: it tracks the Rust sources itself and returns in well under a second when
 # target/ is up to date. Builds the library and the `birefringence` calculator binary.
@@ -91,6 +92,22 @@ $(VENV_STAMP): requirements.txt
 	fi
 	$(VPY) -m pip install $(PIP_FLAGS) -r requirements.txt
 	@touch $@
+
+# Dr.Jit's LLVM backend (the llvm_ad_* variants) needs libLLVM >= 16 at run time; Debian 12's
+# default libLLVM 14/15 fail while compiling kernels. Debian's libllvm19 works, and Dr.Jit finds
+# it without DRJIT_LIBLLVM_PATH. Installed with apt-get (through sudo unless root) when missing;
+# elsewhere install libLLVM >= 16 and point DRJIT_LIBLLVM_PATH at it.
+llvm:
+	@if command -v dpkg >/dev/null 2>&1; then \
+	  if ! dpkg -s libllvm19 >/dev/null 2>&1; then \
+	    echo "installing Debian's libllvm19 (run time of Dr.Jit's LLVM backend: the llvm_ad_* variants)"; \
+	    sudo=$$([ "$$(id -u)" = 0 ] || echo sudo); \
+	    $$sudo apt-get update -qq && \
+	    $$sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq libllvm19 >/dev/null; \
+	  fi; \
+	else \
+	  echo "note: not a Debian system; the llvm_ad_* variants need libLLVM >= 16 (DRJIT_LIBLLVM_PATH)"; \
+	fi
 
 # The plugin library and the package: `import mitsuba; import mitsuba_birefringent` in .venv/
 # registers the BSDFs `thinbirefringent` and `birefringent`. Every run builds the library through
