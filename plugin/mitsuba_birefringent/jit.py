@@ -16,8 +16,9 @@ Evaluated mode is slower than symbolic mode for every BSDF (each loop iteration 
 kernel of its own) and keeps more memory. While any instance of these plugins exists in the
 process, Dr.Jit's symbolic calls trace it too, so a *symbolic* render of another scene (one
 without the plugins) fails with the same error: render that scene inside ``evaluated_mode()``
-as well, or delete every scene and BSDF of the plugins first (``del scene``, then
-``gc.collect()``), or use a separate process.
+as well, or delete every scene and BSDF of the plugins first (``del scene``, and any exception a
+failed render raised: its traceback holds the scene; then ``gc.collect()``), or use a separate
+process.
 """
 
 from __future__ import annotations
