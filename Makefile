@@ -124,11 +124,14 @@ $(EDITABLE_STAMP): pyproject.toml Cargo.toml build_backend/birefringent_backend.
 	@touch $@
 
 # The library alone, against the packages in SITE (the build backend's command; see above).
-# cargo rebuilds it only when its sources (or the wheels) change; it is copied only when it
-# differs.
+# cargo rebuilds it only when its sources or the wheels' versions (WHEELS, their dist-info names)
+# change, not when another environment with the same wheels is named. It replaces the package's
+# copy only when it differs, by a rename (a process that loaded the old one keeps it intact).
+WHEELS = $(shell cd $(SITE) && ls -d mitsuba-*.dist-info drjit-*.dist-info nanobind-*.dist-info | sed 's/\.dist-info$$//')
 plugin-lib:
-	MITSUBA_SITE_PACKAGES=$(SITE) $(CARGO) build --release -p mitsuba-birefringent-plugin
-	@cmp -s $(PLUGIN_BUILT) $(PLUGIN_SO) || { cp $(PLUGIN_BUILT) $(PLUGIN_SO); echo "updated $(PLUGIN_SO)"; }
+	MITSUBA_SITE_PACKAGES=$(SITE) MITSUBA_WHEELS="$(WHEELS)" $(CARGO) build --release -p mitsuba-birefringent-plugin
+	@cmp -s $(PLUGIN_BUILT) $(PLUGIN_SO) || { cp $(PLUGIN_BUILT) $(PLUGIN_SO).new && \
+	  mv -f $(PLUGIN_SO).new $(PLUGIN_SO) && echo "updated $(PLUGIN_SO)"; }
 
 ## ---- main job ---------------------------------------------------------------------------
 

@@ -1,40 +1,74 @@
 //! Compiles the C++ shim (src/*.cpp) against the headers of the `mitsuba`, `drjit` and
 //! `nanobind` wheels of a Python environment and links it with libmitsuba and Dr.Jit.
 //!
-//! The wheels are those of the site-packages directory `MITSUBA_SITE_PACKAGES` (`make
-//! plugin-lib` passes it; the Python build backend, build_backend/, runs that). The compile flags
-//! below must match the flags the PyPI wheels are built with: above all `-march=ivybridge`, which
-//! sets Dr.Jit's array padding and so the layout of Mitsuba's structs (a mismatch compiles,
-//! loads and renders garbage). The library finds libmitsuba and libdrjit through RUNPATHs
-//! relative to itself (`$ORIGIN/../mitsuba`, `$ORIGIN/../drjit`): installed, the package
-//! directory sits beside `mitsuba/` and `drjit/` in site-packages.
+//! The wheels are those of the site-packages directory `MITSUBA_SITE_PACKAGES`; `MITSUBA_WHEELS`
+//! names their versions (e.g. `drjit-1.5.0 mitsuba-3.9.1 nanobind-2.14.0`, the names of their
+//! dist-info directories; `make plugin-lib` passes both, and the Python build backend,
+//! build_backend/, runs that). The build is keyed on the versions, not on the directory: another
+//! environment with the same wheels (pip's isolated build environment) reuses it. The libraries
+//! linked against are copied into the build directory for that reason.
+//!
+//! The compile flags below must match the flags the PyPI wheels are built with: above all
+//! `-march=ivybridge`, which sets Dr.Jit's array padding and so the layout of Mitsuba's structs
+//! (a mismatch compiles, loads and renders garbage). The library finds libmitsuba and libdrjit
+//! through RUNPATHs relative to itself (`$ORIGIN/../mitsuba`, `$ORIGIN/../drjit`): installed,
+//! the package directory sits beside `mitsuba/` and `drjit/` in site-packages.
 
 use std::path::{Path, PathBuf};
 
-/// Where the wheels are: (mitsuba package dir, drjit package dir, nanobind include dir), in the
-/// site-packages directory `site`.
-fn wheels(site: &Path) -> (PathBuf, PathBuf, PathBuf) {
-    let (mitsuba, drjit) = (site.join("mitsuba"), site.join("drjit"));
-    for (dir, file) in [(&mitsuba, "libmitsuba.so"), (&drjit, "libdrjit-core.so")] {
-        if !dir.join(file).is_file() {
+/// The wheels whose headers and libraries the shim is built against.
+const WHEELS: [&str; 3] = ["drjit", "mitsuba", "nanobind"];
+
+/// `name-version` of each wheel installed in `site` (its dist-info directory), sorted.
+fn installed(site: &Path) -> Vec<String> {
+    let entries = std::fs::read_dir(site)
+        .unwrap_or_else(|e| panic!("MITSUBA_SITE_PACKAGES ({}): {e}", site.display()));
+    let mut found: Vec<String> = entries
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .filter_map(|n| n.strip_suffix(".dist-info").map(str::to_string))
+        .filter(|n| WHEELS.iter().any(|w| n.starts_with(&format!("{w}-"))))
+        .collect();
+    found.sort();
+    found
+}
+
+/// The libraries the plugin links, copied from `site` into `dir`.
+fn copy_libraries(site: &Path, dir: &Path) {
+    std::fs::create_dir_all(dir).expect("build directory");
+    for lib in [
+        "mitsuba/libmitsuba.so",
+        "drjit/libdrjit-core.so",
+        "drjit/libdrjit-extra.so",
+        "drjit/libnanothread.so",
+    ] {
+        let from = site.join(lib);
+        let to = dir.join(from.file_name().expect("a file name"));
+        std::fs::copy(&from, &to).unwrap_or_else(|e| {
             panic!(
-                "{} not found: MITSUBA_SITE_PACKAGES ({}) must be the site-packages directory \
-                 holding the mitsuba, drjit and nanobind wheels the plugin is compiled against \
-                 (make setup installs them in .venv/)",
-                dir.join(file).display(),
-                site.display()
-            );
-        }
+                "{}: {e}; MITSUBA_SITE_PACKAGES must hold the mitsuba and drjit wheels",
+                from.display()
+            )
+        });
     }
-    (mitsuba, drjit, site.join("nanobind/include"))
 }
 
 fn main() {
-    println!("cargo:rerun-if-env-changed=MITSUBA_SITE_PACKAGES");
-    let site = std::env::var_os("MITSUBA_SITE_PACKAGES")
-        .map(PathBuf::from)
-        .expect("MITSUBA_SITE_PACKAGES must name the site-packages directory of the mitsuba, drjit and nanobind wheels (make plugin-lib sets it)");
-    let (mitsuba, drjit, nanobind) = wheels(&site);
+    println!("cargo:rerun-if-env-changed=MITSUBA_WHEELS");
+    let site = std::env::var_os("MITSUBA_SITE_PACKAGES").map(PathBuf::from).expect(
+        "MITSUBA_SITE_PACKAGES must name the site-packages directory of the mitsuba, drjit and \
+         nanobind wheels (make plugin-lib sets it)",
+    );
+    let wheels = std::env::var("MITSUBA_WHEELS").unwrap_or_default();
+    let mut given: Vec<String> = wheels.split_whitespace().map(str::to_string).collect();
+    given.sort();
+    let found = installed(&site);
+    if given != found || found.len() != WHEELS.len() {
+        panic!(
+            "MITSUBA_WHEELS ({given:?}) must name the {WHEELS:?} wheels installed in \
+             MITSUBA_SITE_PACKAGES ({}): found {found:?}",
+            site.display()
+        );
+    }
 
     let sources = [
         "src/thinbirefringent.cpp",
@@ -60,20 +94,21 @@ fn main() {
         .flag("-fvisibility=hidden")
         .flag("-Wall");
     for dir in [
-        mitsuba.join("include"),
-        drjit.join("include"),
-        nanobind.clone(),
-        nanobind.join("../ext/robin_map/include"),
+        "mitsuba/include",
+        "drjit/include",
+        "nanobind/include",
+        "nanobind/ext/robin_map/include",
     ] {
+        let dir = site.join(dir);
         build
             .flag("-isystem")
             .flag(dir.to_str().expect("UTF-8 path"));
     }
     build.compile("mitsuba-birefringent-shim");
 
-    for dir in [&mitsuba, &drjit] {
-        println!("cargo:rustc-link-search=native={}", dir.display());
-    }
+    let libs = PathBuf::from(std::env::var("OUT_DIR").expect("OUT_DIR")).join("wheels");
+    copy_libraries(&site, &libs);
+    println!("cargo:rustc-link-search=native={}", libs.display());
     for lib in ["mitsuba", "drjit-core", "drjit-extra", "nanothread"] {
         println!("cargo:rustc-link-lib=dylib={lib}");
     }
@@ -91,16 +126,10 @@ fn main() {
         "src/params.h",
         "src/bridge.h",
         "src/lobes.h",
+        "src/last_valid.h",
+        "src/scalar_texture.h",
+        "src/signed_rgb.h",
     ]) {
         println!("cargo:rerun-if-changed={f}");
     }
-    // A new wheel (another Mitsuba or Dr.Jit) means a rebuild.
-    println!(
-        "cargo:rerun-if-changed={}",
-        mitsuba.join("libmitsuba.so").display()
-    );
-    println!(
-        "cargo:rerun-if-changed={}",
-        drjit.join("libdrjit-core.so").display()
-    );
 }
