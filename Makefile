@@ -31,7 +31,10 @@
 #                 for the plugin fuzzer
 #   make bench    make setup, then the core benchmark on one core (taskset -c 0) and its plot:
 #                 bench/out/core.json, bench/out/core_error_vs_time.png (several minutes), then
-#                 make bench-scenes
+#                 make bench-scenes and make bench-jit
+#   make bench-jit  the plugins in the llvm variants (evaluated mode): render time against
+#                 Mitsuba's dielectric/thindielectric and against the scalar variants, peak
+#                 memory; bench/out/jit.json and bench/out/jit.png
 #   make bench-scenes  the scene benchmarks alone: the core's shortcuts (examples/bench_shortcuts.rs,
 #                 one core), error vs time per scene, overhead against Mitsuba's own plugins;
 #                 writes bench/results.json, bench/out/ (JSON, PNG plots) and README.md's
@@ -65,7 +68,7 @@ PLUGIN_BUILT := target/release/libmitsuba_birefringent.so
 # site-packages of .venv/ (evaluated when used: the venv may not exist yet when make starts)
 SITE = $(shell $(VPY) -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')
 
-.PHONY: help setup build venv llvm plugin plugin-lib render gallery test test-rust test-python fuzz fuzz-ci bench bench-scenes fmt lint clean distclean
+.PHONY: help setup build venv llvm plugin plugin-lib render gallery test test-rust test-python fuzz fuzz-ci bench bench-scenes bench-jit fmt lint clean distclean
 
 help:
 	@sed -n '3,/^$$/s/^# \{0,1\}//p' $(firstword $(MAKEFILE_LIST))
@@ -214,6 +217,14 @@ bench: setup
 	$(TASKSET) $(BENCH_BIN) --validate $(BENCH_PLATES) --out $(BENCH_OUT)/core.json
 	$(VPY) bench/plot_core.py $(BENCH_OUT)/core.json $(BENCH_OUT)/core_error_vs_time.png
 	$(MAKE) --no-print-directory bench-scenes
+	$(MAKE) --no-print-directory bench-jit
+
+# bench/jit.py: the overhead scenes of bench/scenes.py in every llvm variant in evaluated mode
+# (ours against Mitsuba's own plugins, and against ours in the scalar variants), interleaved
+# rounds in one process per variant, peak memory in one process per configuration.
+bench-jit: setup
+	@mkdir -p $(BENCH_OUT)
+	$(VPY) bench/jit.py --out $(BENCH_OUT)
 
 # examples/bench_shortcuts.rs (speed ratios of the core's shortcuts, one core), then
 # bench/scenes.py (every scene module of scenes/: error vs time against an exact
