@@ -8,9 +8,10 @@
 #                 out/gallery/ and the contact sheet scenes/gallery.png (several minutes)
 #   make test     builds everything (make setup), then runs every test: cargo fmt --check, cargo
 #                 clippy (warnings are errors), cargo's tests, then pytest's, then make fuzz-ci
-#   make setup    cargo build --release, the virtualenv .venv/ from requirements.txt, the
-#                 Mitsuba plugin library (cpp/) and the mitsuba_birefringent package in .venv/;
-#                 idempotent, and quick when nothing changed
+#   make setup    cargo build --release, the virtualenv .venv/ from requirements.txt, Debian's
+#                 libllvm19 if missing (for Mitsuba's llvm_ad_* variants), the Mitsuba plugin
+#                 library (cpp/) and the mitsuba_birefringent package in .venv/; idempotent,
+#                 and quick when nothing changed
 #   make plugin   (part of setup) the plugin library plugin/mitsuba_birefringent/*.so and the
 #                 package in .venv/ (an editable install: `pip install -e .`, the same build as
 #                 `pip install .` and `pip wheel .`, see pyproject.toml), with its command
@@ -30,7 +31,10 @@
 #                 for the plugin fuzzer
 #   make bench    make setup, then the core benchmark on one core (taskset -c 0) and its plot:
 #                 bench/out/core.json, bench/out/core_error_vs_time.png (several minutes), then
-#                 make bench-scenes
+#                 make bench-scenes and make bench-jit
+#   make bench-jit  the plugins in the llvm variants (evaluated mode): render time against
+#                 Mitsuba's dielectric/thindielectric and against the scalar variants, peak
+#                 memory; bench/out/jit.json and bench/out/jit.png
 #   make bench-scenes  the scene benchmarks alone: the core's shortcuts (examples/bench_shortcuts.rs,
 #                 one core), error vs time per scene, overhead against Mitsuba's own plugins;
 #                 writes bench/results.json, bench/out/ (JSON, PNG plots) and README.md's
@@ -54,41 +58,24 @@ PYTESTS := tests/python
 
 PIP_FLAGS := --disable-pip-version-check --no-input --progress-bar off
 
-# The Mitsuba plugin library: the C++ shim (cpp/src/*.cpp) + the Rust core's static library,
-# compiled against the headers of the mitsuba/drjit/nanobind wheels in SITE, written into the
-# Python package plugin/mitsuba_birefringent/. The Python build backend
+# The Mitsuba plugin library: the crate cpp/ (the C++ shim, compiled by cpp/build.rs against the
+# headers of the mitsuba/drjit/nanobind wheels in SITE with the wheel-matching flags, linked with
+# the core), copied into the Python package plugin/mitsuba_birefringent/. The Python build backend
 # (build_backend/birefringent_backend.py, BUILD_COMMAND) builds it with `make plugin-lib`, passing
-# the site-packages of its build environment as SITE (.venv/'s for make setup), VENV_STAMP= (no
-# virtualenv is needed) and CPP_OBJ_DIR=target/cpp/<versions of the headers' packages>.
-RUST_LIB := target/release/libbirefringent.a
-CPP_OBJ_DIR := target/cpp
-CPP_SRCS := $(wildcard cpp/src/*.cpp)
-CPP_OBJS := $(patsubst cpp/src/%.cpp,$(CPP_OBJ_DIR)/%.o,$(CPP_SRCS))
-CPP_HDRS := $(wildcard cpp/src/*.h) cpp/include/birefringent.h
+# the site-packages of its build environment as SITE (.venv/'s for make setup).
 PLUGIN_SO := plugin/mitsuba_birefringent/libmitsuba_birefringent.so
+PLUGIN_BUILT := target/release/libmitsuba_birefringent.so
 # site-packages of .venv/ (evaluated when used: the venv may not exist yet when make starts)
 SITE = $(shell $(VPY) -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')
-# These flags must match the PyPI wheels (see docs/building.md): above all -march=ivybridge,
-# which sets Dr.Jit's array padding and so the layout of Mitsuba's structs. The RUNPATH finds
-# libmitsuba and libdrjit-core beside the package in site-packages (the wheel's layout).
-MI_CXXFLAGS = -std=c++17 -O2 -fPIC -fvisibility=hidden -march=ivybridge -ffp-contract=fast \
-  -fno-math-errno -DNDEBUG -DMI_ENABLE_LLVM=1 -DMI_ENABLE_CUDA=1 -DMI_ENABLE_EMBREE=1 \
-  -DMI_ENABLE_AUTODIFF=1 -Wall -Icpp/include -isystem $(SITE)/mitsuba/include \
-  -isystem $(SITE)/drjit/include -isystem $(SITE)/nanobind/include \
-  -isystem $(SITE)/nanobind/ext/robin_map/include
-MI_LDFLAGS = -shared -L$(SITE)/mitsuba -lmitsuba -L$(SITE)/drjit -ldrjit-core \
-  -Wl,-rpath,'$$ORIGIN/../mitsuba' -Wl,-rpath,'$$ORIGIN/../drjit' \
-  -Wl,--exclude-libs,ALL -Wl,--gc-sections -Wl,--strip-debug -Wl,--no-undefined \
-  -lpthread -ldl -lm
 
-.PHONY: help setup build venv plugin plugin-lib render gallery test test-rust test-python fuzz fuzz-ci bench bench-scenes fmt lint clean distclean
+.PHONY: help setup build venv llvm plugin plugin-lib render gallery test test-rust test-python fuzz fuzz-ci bench bench-scenes bench-jit fmt lint clean distclean
 
 help:
 	@sed -n '3,/^$$/s/^# \{0,1\}//p' $(firstword $(MAKEFILE_LIST))
 
 ## ---- set-up -------------------------------------------------------------------------------
 
-setup: build venv plugin
+setup: build venv llvm plugin
 
 # Always asks cargo: it tracks the Rust sources itself and returns in well under a second when
 # target/ is up to date. Builds the library and the `birefringence` calculator binary.
@@ -109,6 +96,22 @@ $(VENV_STAMP): requirements.txt
 	$(VPY) -m pip install $(PIP_FLAGS) -r requirements.txt
 	@touch $@
 
+# Dr.Jit's LLVM backend (the llvm_ad_* variants) needs libLLVM >= 16 at run time; Debian 12's
+# default libLLVM 14/15 fail while compiling kernels. Debian's libllvm19 works, and Dr.Jit finds
+# it without DRJIT_LIBLLVM_PATH. Installed with apt-get (through sudo unless root) when missing;
+# elsewhere install libLLVM >= 16 and point DRJIT_LIBLLVM_PATH at it.
+llvm:
+	@if command -v dpkg >/dev/null 2>&1; then \
+	  if ! dpkg -s libllvm19 >/dev/null 2>&1; then \
+	    echo "installing Debian's libllvm19 (run time of Dr.Jit's LLVM backend: the llvm_ad_* variants)"; \
+	    sudo=$$([ "$$(id -u)" = 0 ] || echo sudo); \
+	    $$sudo apt-get update -qq && \
+	    $$sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq libllvm19 >/dev/null; \
+	  fi; \
+	else \
+	  echo "note: not a Debian system; the llvm_ad_* variants need libLLVM >= 16 (DRJIT_LIBLLVM_PATH)"; \
+	fi
+
 # The plugin library and the package: `import mitsuba; import mitsuba_birefringent` in .venv/
 # registers the BSDFs `thinbirefringent` and `birefringent`. Every run builds the library through
 # the build backend, i.e. with the same command as `pip install .`; the package is installed
@@ -124,19 +127,14 @@ $(EDITABLE_STAMP): pyproject.toml Cargo.toml build_backend/birefringent_backend.
 	@touch $@
 
 # The library alone, against the packages in SITE (the build backend's command; see above).
+# cargo rebuilds it only when its sources or the wheels' versions (WHEELS, their dist-info names)
+# change, not when another environment with the same wheels is named. It replaces the package's
+# copy only when it differs, by a rename (a process that loaded the old one keeps it intact).
+WHEELS = $(shell cd $(SITE) && ls -d mitsuba-*.dist-info drjit-*.dist-info nanobind-*.dist-info | sed 's/\.dist-info$$//')
 plugin-lib:
-	$(CARGO) build --release --lib
-	@$(MAKE) --no-print-directory $(PLUGIN_SO)
-
-$(CPP_OBJ_DIR)/%.o: cpp/src/%.cpp $(CPP_HDRS) $(VENV_STAMP)
-	@mkdir -p $(@D)
-	$(CXX) $(MI_CXXFLAGS) -c $< -o $@
-
-$(PLUGIN_SO): $(CPP_OBJS) $(RUST_LIB)
-	$(CXX) -o $@ $(CPP_OBJS) $(RUST_LIB) $(MI_LDFLAGS)
-
-$(RUST_LIB):
-	$(CARGO) build --release --lib
+	MITSUBA_SITE_PACKAGES=$(SITE) MITSUBA_WHEELS="$(WHEELS)" $(CARGO) build --release -p mitsuba-birefringent-plugin
+	@cmp -s $(PLUGIN_BUILT) $(PLUGIN_SO) || { cp $(PLUGIN_BUILT) $(PLUGIN_SO).new && \
+	  mv -f $(PLUGIN_SO).new $(PLUGIN_SO) && echo "updated $(PLUGIN_SO)"; }
 
 ## ---- main job ---------------------------------------------------------------------------
 
@@ -219,6 +217,14 @@ bench: setup
 	$(TASKSET) $(BENCH_BIN) --validate $(BENCH_PLATES) --out $(BENCH_OUT)/core.json
 	$(VPY) bench/plot_core.py $(BENCH_OUT)/core.json $(BENCH_OUT)/core_error_vs_time.png
 	$(MAKE) --no-print-directory bench-scenes
+	$(MAKE) --no-print-directory bench-jit
+
+# bench/jit.py: the overhead scenes of bench/scenes.py in every llvm variant in evaluated mode
+# (ours against Mitsuba's own plugins, and against ours in the scalar variants), interleaved
+# rounds in one process per variant, peak memory in one process per configuration.
+bench-jit: setup
+	@mkdir -p $(BENCH_OUT)
+	$(VPY) bench/jit.py --out $(BENCH_OUT)
 
 # examples/bench_shortcuts.rs (speed ratios of the core's shortcuts, one core), then
 # bench/scenes.py (every scene module of scenes/: error vs time against an exact

@@ -16,7 +16,7 @@ the Python package `plugin/mitsuba_birefringent/` into a wheel:
 - the console script of `[project.scripts]`.
 
 The library finds libmitsuba and libdrjit-core through its RUNPATH `$ORIGIN/../mitsuba` and
-`$ORIGIN/../drjit` (set by the link flags of the Makefile), i.e. beside itself in site-packages.
+`$ORIGIN/../drjit` (set by the link flags of cpp/build.rs), i.e. beside itself in site-packages.
 
 Only the standard library is used (tomllib: Python >= 3.11).
 """
@@ -39,10 +39,9 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 
 #: The one command that builds the plugin library, against the mitsuba/drjit/nanobind packages
-#: installed in the directory `{site}` (headers, libmitsuba, libdrjit-core); `{objects}` is a
-#: directory for intermediate files, one per set of header versions.
-BUILD_COMMAND = ("make", "--no-print-directory", "plugin-lib", "SITE={site}", "VENV_STAMP=",
-                 "CPP_OBJ_DIR={objects}")
+#: installed in the directory `{site}` (headers, libmitsuba, libdrjit-core): cargo builds the
+#: crate cpp/ (cpp/build.rs compiles the shim), rebuilding when `{site}` or its wheels change.
+BUILD_COMMAND = ("make", "--no-print-directory", "plugin-lib", "SITE={site}")
 #: The file the build command writes (relative to the repository root).
 LIBRARY = "plugin/mitsuba_birefringent/libmitsuba_birefringent.so"
 
@@ -55,8 +54,8 @@ BUILT_AGAINST = ("mitsuba", "drjit")
 #: Headers only (Mitsuba's headers include nanobind's).
 HEADERS_ONLY = ("nanobind",)
 #: What an sdist holds: everything the build command needs.
-SDIST_PATHS = ("pyproject.toml", "build_backend", "Cargo.toml", "Cargo.lock", "Makefile",
-               "requirements.txt", "README.md", "src", "cpp", "plugin")
+SDIST_PATHS = ("pyproject.toml", "build_backend", "Cargo.toml", "Cargo.lock", "build.rs",
+               "Makefile", "requirements.txt", "README.md", "src", "cpp", "plugin")
 #: [project] keys this backend implements (any other key is an error, not silently dropped).
 PROJECT_KEYS = {"name", "description", "readme", "requires-python", "license", "scripts",
                 "dynamic"}
@@ -102,9 +101,7 @@ def requirements() -> list[str]:
 
 def build_library() -> Path:
     """Runs the build command for this interpreter's mitsuba/drjit/nanobind; returns the library."""
-    versions = "-".join(f"{n}-{importlib.metadata.version(n)}" for n in BUILT_AGAINST + HEADERS_ONLY)
-    fields = {"site": build_site(), "objects": Path("target/cpp") / versions}
-    command = [arg.format(**fields) for arg in BUILD_COMMAND]
+    command = [arg.format(site=build_site()) for arg in BUILD_COMMAND]
     subprocess.run(command, cwd=ROOT, check=True)
     library = ROOT / LIBRARY
     if not library.is_file():

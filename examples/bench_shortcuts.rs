@@ -12,7 +12,7 @@
 //! `full / shortcut` (how many times faster the shortcut is). The shortcuts and where the core
 //! decides them:
 //!
-//! * `intensity_only` (`BFR_INTENSITY_ONLY`, set by the plugin in the unpolarised variants;
+//! * `intensity_only` (`PlateCall::intensity_only`, set by the plugin in the unpolarised variants;
 //!   `Output::Intensity` in `spectral::integrate::band_sum`): only `M00` of each path-class pair
 //!   instead of the full coherency matrix. Full = the same query with `Output::Mueller`. It acts
 //!   only where the closed-form path sum runs (band-filtered or RGB queries of plates too thick

@@ -69,11 +69,13 @@ def render(name: str, out: pathlib.Path, variant: str | None = None, seed: int =
     """Renders scene `name` with `options` to `<out>/<name>.exr` and `.png`; returns the PNG."""
     module = importlib.import_module(name)
     mi.set_variant(variant or module.VARIANTS[0])
-    import mitsuba_birefringent  # noqa: F401  (registers the plugins for the variant set)
+    import mitsuba_birefringent  # registers the plugins for the variant set
 
     scene = mi.load_dict(module.scene(**options))
     start = time.perf_counter()
-    image = mi.render(scene, seed=seed)
+    # The plugins work in the JIT variants in evaluated mode only (no-op in scalar variants).
+    with mitsuba_birefringent.evaluated_mode():
+        image = mi.render(scene, seed=seed)
     seconds = time.perf_counter() - start
     out.mkdir(parents=True, exist_ok=True)
     exr = out / f"{name}.exr"

@@ -3,9 +3,20 @@
 
 use std::fmt;
 
-/// An invalid input or a physically undefined query.
+/// What kind of failure an [`Error`] is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ErrorKind {
+    /// The input is invalid or the query physically undefined: the user's to fix.
+    Invalid,
+    /// A defect of the core (a caught panic, a non-finite result): never the user's input alone.
+    Internal,
+}
+
+/// An invalid input, a physically undefined query, or an internal defect.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Error {
+    /// Invalid input or internal defect.
+    pub kind: ErrorKind,
     /// The parameter at fault (e.g. `"eta_o"`, `"optic_axis"`), or the quantity that is undefined.
     pub parameter: String,
     /// What is wrong with it, in words a user can act on.
@@ -13,10 +24,20 @@ pub struct Error {
 }
 
 impl Error {
-    /// An error about parameter `parameter`.
+    /// An error about parameter `parameter` (an [`ErrorKind::Invalid`] input).
     pub fn new(parameter: impl Into<String>, message: impl Into<String>) -> Self {
         Error {
+            kind: ErrorKind::Invalid,
             parameter: parameter.into(),
+            message: message.into(),
+        }
+    }
+
+    /// An [`ErrorKind::Internal`] defect; `what` names the quantity that went wrong.
+    pub fn internal(what: impl Into<String>, message: impl Into<String>) -> Self {
+        Error {
+            kind: ErrorKind::Internal,
+            parameter: what.into(),
             message: message.into(),
         }
     }

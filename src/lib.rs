@@ -17,5 +17,5 @@ pub mod plate;
 pub mod render;
 pub mod spectral;
 
-pub use error::{Error, Result};
+pub use error::{Error, ErrorKind, Result};
 pub use num_complex::Complex64 as C64;

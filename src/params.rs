@@ -1,4 +1,4 @@
-//! Validated parameters. Each is checked once, where it enters the core (the C ABI for the
+//! Validated parameters. Each is checked once, where it enters the core (the bridge for the
 //! plugins, the JSON reader for the calculator), with the name and the unit the caller's user
 //! wrote, and becomes a value that the constructors inside the core take without checking
 //! again. One rule per parameter, here; each boundary passes its own name: the plugin's

@@ -1,14 +1,13 @@
 //! Named crystals over the wavelengths Mitsuba samples (360-830 nm), where some crystals' cited
 //! data stop short (rutile: 430 nm, lithium niobate: 400 nm): the one rule of
-//! `Material::coverage`, as the core, the calculator (`calc::run_text`) and the C ABI the
+//! `Material::coverage`, as the core, the calculator (`calc::run_text`) and the bridge the
 //! plugins load materials through apply it.
 
 use birefringent::calc::run_text;
-use birefringent::ffi::{bfr_material_free, bfr_material_new, BfrComplex, BfrMaterialDesc};
+use birefringent::ffi::new_materials;
 use birefringent::material::crystals::{crystal, crystal_names};
 use birefringent::material::{Material, RENDER_RANGE_NM};
 use serde_json::json;
-use std::ffi::{CStr, CString};
 
 fn nm_grid() -> impl Iterator<Item = f64> {
     (RENDER_RANGE_NM.0 as u32..=RENDER_RANGE_NM.1 as u32).map(f64::from)
@@ -113,28 +112,11 @@ fn wavelengths_beyond_the_data_and_the_render_range_are_refused() {
     assert!(ok && out.get("warnings").is_none(), "{out}");
 }
 
-/// `bfr_material_new`'s message after success: the warning the plugins log at load.
+/// The bridge's warning for a loaded material: what the plugins log at load.
 fn load_message(name: &str) -> String {
-    let cname = CString::new(name).unwrap();
-    let zero = BfrComplex { re: 0.0, im: 0.0 };
-    let desc = BfrMaterialDesc {
-        material: cname.as_ptr(),
-        eta_o: zero,
-        eta_e: zero,
-        kappa_o: 0.0,
-        kappa_e: 0.0,
-    };
-    let mut buf = vec![b'x' as std::os::raw::c_char; 1024];
-    // SAFETY: valid descriptor and buffer of the stated length.
-    let m = unsafe { bfr_material_new(&desc, buf.as_mut_ptr(), buf.len()) };
-    assert!(!m.is_null());
-    // SAFETY: created above, freed once.
-    unsafe { bfr_material_free(m) };
-    // SAFETY: write_message NUL-terminates within the buffer.
-    unsafe { CStr::from_ptr(buf.as_ptr()) }
-        .to_str()
-        .unwrap()
-        .to_string()
+    let mut table = new_materials();
+    let index = table.add_named(name, 0.0, 0.0).unwrap();
+    table.warning(index)
 }
 
 #[test]

@@ -768,7 +768,7 @@ fn special_configurations() {
     assert!(st.singular.is_empty(), "singular: {:?}", st.singular);
 }
 
-/// The product (calculator, C ABI, plugins) refuses absorbing exterior media: with complex `β`
+/// The product (calculator, bridge, plugins) refuses absorbing exterior media: with complex `β`
 /// the incident plane wave is inhomogeneous, power fractions are not defined, and whether the
 /// decaying or the energy-carrying root is "transmitted" is a convention (the library's
 /// `Interface` uses decay; `complex_exterior` above compares exactly that).

@@ -73,7 +73,7 @@ fn isotropic_crystal_weights_are_mitsubas_dielectric_weights() {
     );
 }
 
-/// BFR_INTENSITY_ONLY's contract (cpp/include/birefringent.h): only M00 is computed, every other
+/// The intensity-only contract (`PlateCall::intensity_only` of the bridge): only M00 is computed, every other
 /// Mueller entry is zero, and M00 equals the full query's; exact and band-filtered, isotropic
 /// and birefringent plates (the fuzzer found the exact birefringent plate returning all 16).
 #[test]

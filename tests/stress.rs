@@ -1,15 +1,17 @@
-//! Stress suite (issue 6, part 1): adversarial inputs for the interface, the plate and the C ABI
-//! entry points the Mitsuba shim calls. Every case must give finite numbers, respect the energy
+//! Stress suite (issue 6, part 1): adversarial inputs for the interface, the plate and the
+//! bridge entry points the Mitsuba shim calls. Every case must give finite numbers, respect the energy
 //! bounds, give physically valid Mueller matrices, and be continuous across the total internal
 //! reflection edge and the two degeneracies (optic axis along the wave vector, eta_e -> eta_o).
 //!
 //! Each test prints the number of cases and its worst figures (run with `--nocapture`).
 //! Tolerances are stated where they are asserted, with the reason.
 
+use birefringent::ffi::bridge::{
+    CrystalLanes, PlateCall, PlateLanes, Samples, Status, Transport as T,
+};
 use birefringent::ffi::{
-    bfr_crystal_lobes, bfr_material_free, bfr_material_new, bfr_plate_lobes, BfrComplex,
-    BfrGeometry, BfrMaterialDesc, BfrPathLobe, BFR_CRYSTAL_LOBES, BFR_IMPORTANCE, BFR_INVALID,
-    BFR_OK, BFR_RADIANCE, BFR_WANT_REFLECTION, BFR_WANT_TRANSMISSION,
+    band_spectrum, exact_spectrum, new_materials, sample_crystal, sample_plate, Materials,
+    PlateSpectrum,
 };
 use birefringent::material::Material;
 use birefringent::optics::frame::PlaneFrame;
@@ -17,11 +19,14 @@ use birefringent::optics::interface::Interface;
 use birefringent::optics::medium::Uniaxial;
 use birefringent::optics::modes::ModeKind;
 use birefringent::optics::surface::{Incident, Surface};
+use birefringent::params::Thickness;
 use birefringent::plate::slab::{Slab, Want};
 use birefringent::plate::Plate;
+use birefringent::render::crystal::crystal_slots;
+use birefringent::render::plate::{plate_lobes, PlateQuery, Spectrum};
+use birefringent::render::Transport;
 use birefringent::C64;
 use nalgebra::{Matrix4, Vector3};
-use std::ffi::CString;
 
 mod common;
 use common::Rng;
@@ -616,25 +621,103 @@ fn f32_direction(theta: f64, phi: f64, sign: f64) -> [f64; 3] {
     v.map(|x| (x / n) as f64)
 }
 
-fn material_handle(desc: &BfrMaterialDesc) -> *mut birefringent::ffi::BfrMaterial {
-    let mut msg = [0 as std::os::raw::c_char; 256];
-    // SAFETY: valid descriptor and message buffer.
-    let m = unsafe { bfr_material_new(desc, msg.as_mut_ptr(), msg.len()) };
-    assert!(!m.is_null());
-    m
+/// One lane sent through the bridge as the scalar variants send it; `Err` is the message of a
+/// failed lane; `Ok` holds (pdf, eta, M00 and the whole sampled Mueller matrix times the pdf).
+struct OneLane<'a> {
+    materials: &'a Materials,
+    wavelength: f64,
+    wi: [f64; 3],
+    transport: T,
+    ext_ior: f64,
+    optic_axis: [f64; 3],
+}
+
+type Sampled = Result<Option<(f64, f64, Matrix4<f64>)>, String>;
+
+impl OneLane<'_> {
+    fn run(&self, u: f64, plate: Option<(&PlateSpectrum, f64, f64)>) -> Sampled {
+        let (mut status, mut component) = ([Status::Ok], [0u32]);
+        let mut cols = [[0.0f64; 1]; 5 + 6 + 16];
+        let [pdf, eta, w0, w1, w2, i0, i1, i2, o0, o1, o2, values @ ..] = &mut cols;
+        let mut values = values.iter_mut();
+        let mut out = Samples {
+            status: &mut status,
+            component: &mut component,
+            pdf,
+            eta,
+            wo: [w0, w1, w2],
+            in_stokes_x: [i0, i1, i2],
+            out_stokes_x: [o0, o1, o2],
+            value: std::array::from_fn(|_| values.next().unwrap().as_mut_slice()),
+            message: String::new(),
+        };
+        let wave = [self.wavelength];
+        let waves: [&[f64]; 1] = [&wave];
+        let a = self.optic_axis;
+        let (w, t) = (self.wi, [self.transport]);
+        let rc = match plate {
+            None => {
+                let lanes = CrystalLanes {
+                    count: 1,
+                    active: &[1],
+                    material: &[0],
+                    transport: &t,
+                    sample: &[u],
+                    wi: [&w[0..1], &w[1..2], &w[2..3]],
+                    wavelengths_nm: &waves,
+                    ext_ior: &[self.ext_ior],
+                    optic_axis: [&a[0..1], &a[1..2], &a[2..3]],
+                };
+                sample_crystal(self.materials, 7, &lanes, &mut out)
+            }
+            Some((spectrum, exit_ior, thickness_nm)) => {
+                let lanes = PlateLanes {
+                    count: 1,
+                    active: &[1],
+                    material: &[0],
+                    transport: &t,
+                    sample: &[u],
+                    wi: [&w[0..1], &w[1..2], &w[2..3]],
+                    wavelengths_nm: &waves,
+                    ext_ior: &[self.ext_ior],
+                    exit_ior: &[exit_ior],
+                    optic_axis: [&a[0..1], &a[1..2], &a[2..3]],
+                    axis_angle_deg: &[0.0],
+                    thickness_nm: &[thickness_nm],
+                    birefringence: &[0.0],
+                };
+                let call = PlateCall {
+                    components: 3,
+                    intensity_only: false,
+                    absorbing_exit: false,
+                };
+                sample_plate(self.materials, spectrum, &call, &lanes, &mut out)
+            }
+        };
+        if rc != Status::Ok {
+            return Err(format!("{rc:?}: {}", out.message));
+        }
+        let p = out.pdf[0];
+        if p == 0.0 {
+            return Ok(None);
+        }
+        let m = Matrix4::from_fn(|r, c| out.value[4 * r + c][0] * p);
+        Ok(Some((p, out.eta[0], m)))
+    }
 }
 
 #[test]
-fn c_abi_with_f32_inputs_as_the_shim_passes_them() {
-    // Through bfr_crystal_lobes and bfr_plate_lobes exactly as cpp/src calls them: directions
-    // and axes rounded to f32 (not unit length), both transport modes, grazing directions down
-    // to wi.z ~ 1e-7 and exact normal incidence. Every call on valid input must return BFR_OK
-    // with finite lobes and valid Mueller matrices (to 1e-12); in Importance mode the weights
-    // are power fractions: for lossless crystals and exact plates their sum over the lobes is
-    // <= 1 + 1e-9 (the core renormalises wi, so f32 rounding does not create energy; the slack
-    // covers the balance near grazing).
+fn bridge_with_f32_inputs_as_the_shim_passes_them() {
+    // Through the bridge exactly as cpp/src calls it in the scalar variants (one-lane batches):
+    // directions and axes rounded to f32 (not unit length), both transport modes, grazing
+    // directions down to wi.z ~ 1e-7 and exact normal incidence, lobes chosen with u = 0, 0.35,
+    // 0.7, 0.999. Every call on valid input must succeed, each sampled Mueller matrix (times its
+    // pdf) valid to 1e-12 and, in Importance mode for lossless media, <= 1 + 1e-9; the sum of
+    // all lobes' weights (the core's `crystal_slots` / `plate_lobes` on the same f32 inputs,
+    // which the bridge samples from bit for bit, tests/batch.rs) is <= 1 + 1e-9 in Importance
+    // mode (the core renormalises wi, so f32 rounding does not create energy; the slack covers
+    // the balance near grazing).
     let mut rng = Rng::new(66);
-    let names: Vec<CString> = NAMED.iter().map(|n| CString::new(n.0).unwrap()).collect();
     let (mut calls, mut worst_mueller, mut worst_sum) = (0usize, 0.0f64, 0.0f64);
     let mut lossless_sum_err = 0.0f64;
     let mut slowest = 0.0f64;
@@ -643,7 +726,7 @@ fn c_abi_with_f32_inputs_as_the_shim_passes_them() {
     let (mut worst_band, mut worst_band_case) = (0.0f64, String::new());
     let (mut unbounded, mut max_unbounded) = (0usize, [0.0f64; 2]);
     let (mut worst_sum_case, mut slowest_case) = (String::new(), String::new());
-    let mut msg = [0 as std::os::raw::c_char; 512];
+    let (exact, band) = (exact_spectrum(), band_spectrum(4.0));
     for n_case in 0..3000 {
         let named = n_case % 2 == 0;
         let idx = rng.index(NAMED.len());
@@ -655,45 +738,29 @@ fn c_abi_with_f32_inputs_as_the_shim_passes_them() {
                 10f64.powf(rng.range(-6.0, 1.3))
             }
         };
-        let desc = if named {
-            BfrMaterialDesc {
-                material: names[idx].as_ptr(),
-                eta_o: BfrComplex::default(),
-                eta_e: BfrComplex::default(),
-                kappa_o: kappa(&mut rng),
-                kappa_e: kappa(&mut rng),
-            }
+        let mut table = new_materials();
+        let (ko, ke) = (kappa(&mut rng) as f32 as f64, kappa(&mut rng) as f32 as f64);
+        let (material, isotropic, dn) = if named {
+            table.add_named(NAMED[idx].0, ko, ke).unwrap();
+            (Material::named(NAMED[idx].0, ko, ke).unwrap(), false, 0.3)
         } else {
             let (o, e) = (random_index(&mut rng, true), random_index(&mut rng, true));
             let e = if rng.chance(0.1) { o } else { e };
-            BfrMaterialDesc {
-                material: std::ptr::null(),
-                eta_o: BfrComplex {
-                    re: o.re as f32 as f64,
-                    im: 0.0,
-                },
-                eta_e: BfrComplex {
-                    re: e.re as f32 as f64,
-                    im: 0.0,
-                },
-                kappa_o: kappa(&mut rng) as f32 as f64,
-                kappa_e: kappa(&mut rng) as f32 as f64,
-            }
+            let (o, e) = (o.re as f32 as f64, e.re as f32 as f64);
+            table.add_constant(o, e, ko, ke).unwrap();
+            let m = Material::constant(C64::new(o, ko), C64::new(e, ke)).unwrap();
+            (m, o == e && ko == ke, (e - o).abs())
         };
-        let m = material_handle(&desc);
         let lambda = if named {
             rng.range(NAMED[idx].1, 1000.0)
         } else {
             rng.range(300.0, 1000.0)
         };
         let a = rng.unit_vector();
-        let g = BfrGeometry {
-            ext_ior: rng.range(1.0, 1.8) as f32 as f64,
-            exit_ior: rng.range(1.0, 1.8) as f32 as f64,
-            optic_axis: [a.x as f32 as f64, a.y as f32 as f64, a.z as f32 as f64],
-            thickness_nm: 1000.0 * (10f64.powf(rng.range(-3.0, 5.0)) as f32 as f64),
-            birefringence: 0.0,
-        };
+        let axis = [a.x as f32 as f64, a.y as f32 as f64, a.z as f32 as f64];
+        let ext_ior = rng.range(1.0, 1.8) as f32 as f64;
+        let exit_ior = rng.range(1.0, 1.8) as f32 as f64;
+        let thickness_nm = 1000.0 * (10f64.powf(rng.range(-3.0, 5.0)) as f32 as f64);
         let theta = match n_case % 6 {
             0 => 0.0,
             1 => std::f64::consts::FRAC_PI_2 - 1e-7,
@@ -702,180 +769,168 @@ fn c_abi_with_f32_inputs_as_the_shim_passes_them() {
         };
         let sign = if rng.chance(0.5) { 1.0 } else { -1.0 };
         let wi = f32_direction(theta, rng.range(0.0, 6.3), sign);
-        for transport in [BFR_RADIANCE, BFR_IMPORTANCE] {
-            let mut out = [BfrPathLobe::default(); BFR_CRYSTAL_LOBES];
-            // SAFETY: valid handle, geometry, direction, output and message buffers.
-            let rc = unsafe {
-                bfr_crystal_lobes(
-                    m,
-                    &g,
-                    lambda,
-                    wi.as_ptr(),
-                    transport,
-                    out.as_mut_ptr(),
-                    msg.as_mut_ptr(),
-                    msg.len(),
-                )
-            };
-            calls += 1;
-            let text = unsafe { std::ffi::CStr::from_ptr(msg.as_ptr()) }
-                .to_string_lossy()
-                .into_owned();
-            // An absorbing birefringent crystal is refused as a bulk surface (its per-ray powers
-            // are undefined): a clear error naming the kappa that is given, never lobes.
-            let isotropic =
-                !named && desc.eta_o.re == desc.eta_e.re && desc.kappa_o == desc.kappa_e;
-            if !lossless && !isotropic && (desc.kappa_o > 0.0 || desc.kappa_e > 0.0) {
-                assert_eq!(rc, BFR_INVALID, "absorbing crystal accepted: {desc:?}");
-                let named = if desc.kappa_o > 0.0 {
-                    "kappa_o:"
-                } else {
-                    "kappa_e:"
-                };
-                assert!(text.starts_with(named), "{text}");
-                refused += 1;
+        let case = format!(
+            "{} ko {ko} ke {ke} axis {axis:?} ext {ext_ior} exit {exit_ior} d {thickness_nm} wi {wi:?} lambda {lambda}",
+            if named { NAMED[idx].0 } else { "constant" }
+        );
+        for transport in [T::Radiance, T::Importance] {
+            let importance = transport == T::Importance;
+            let core_transport = if importance {
+                Transport::Importance
             } else {
-                assert_eq!(
-                    rc, BFR_OK,
-                    "crystal: {text} desc {desc:?} g {g:?} wi {wi:?} lambda {lambda}"
-                );
-                let mut sum = 0.0;
-                // Absorbing crystals: the per-wave power fractions leave out the interference terms
-                // of the flux (o with e below the surface; incident with reflected inside), so
-                // their sum has no bound (see `balance`); measured and reported, not asserted.
-                let bounded = transport == BFR_IMPORTANCE && lossless;
-                for l in out.iter().filter(|l| l.exists == 1) {
-                    let mm = Matrix4::from_row_slice(&l.mueller);
-                    let bound = if bounded { 1.0 + 1e-9 } else { f64::INFINITY };
-                    worst_mueller = worst_mueller.max(mueller_violation(&mm, bound));
-                    assert!(
-                        l.weight >= 0.0 && l.eta.is_finite() && l.eta != 0.0,
-                        "lobe {l:?}"
-                    );
-                    // bs.eta is a ratio of ray indices (eq. S14): positive for lossless media.
-                    // In strongly absorbing crystals the core's ray index Re(η_ef) ⟨W, ray⟩ can be
-                    // negative (the Poynting vector more than 90° from Re k); counted and reported.
-                    if l.eta < 0.0 {
-                        assert!(
-                            desc.kappa_o > 0.0 || desc.kappa_e > 0.0,
-                            "eta < 0, lossless: {l:?}"
-                        );
-                        negative_eta += 1;
-                        if negative_eta == 1 {
-                            let name = if named { NAMED[idx].0 } else { "constant" };
-                            println!("C ABI: first eta < 0: {name} {desc:?} {g:?} wi {wi:?} lambda {lambda} transport {transport}: {l:?}");
-                        }
-                    }
-                    sum += l.weight;
+                Transport::Radiance
+            };
+            let lane = OneLane {
+                materials: &table,
+                wavelength: lambda,
+                wi,
+                transport,
+                ext_ior,
+                optic_axis: axis,
+            };
+            // An absorbing birefringent crystal is refused as a bulk surface (its per-ray powers
+            // are undefined): a clear error naming kappa, never lobes.
+            let absorbing = ko > 0.0 || ke > 0.0;
+            let refused_bulk = absorbing && !isotropic;
+            for u in [0.0, 0.35, 0.7, 0.999] {
+                let r = lane.run(u, None);
+                calls += 1;
+                if refused_bulk {
+                    // A clear error naming the kappa that is given, never lobes.
+                    let e = r.expect_err("absorbing crystal accepted");
+                    let named = if ko > 0.0 { "kappa_o:" } else { "kappa_e:" };
+                    assert!(e.starts_with(&format!("Invalid: {named}")), "{e}");
+                    refused += 1;
+                    continue;
                 }
-                if transport == BFR_IMPORTANCE && !bounded {
+                let r = r.unwrap_or_else(|e| panic!("crystal: {e} for {case}"));
+                if let Some((_, eta, m)) = r {
+                    let bound = if importance && lossless {
+                        1.0 + 1e-9
+                    } else {
+                        f64::INFINITY
+                    };
+                    worst_mueller = worst_mueller.max(mueller_violation(&m, bound));
+                    assert!(eta.is_finite() && eta != 0.0, "eta {eta} for {case}");
+                    // bs.eta is a ratio of ray indices (eq. S14): positive for lossless
+                    // media. In strongly absorbing crystals the core's ray index can be
+                    // negative (the Poynting vector more than 90° from Re k); counted.
+                    if eta < 0.0 {
+                        assert!(absorbing, "eta < 0, lossless: {case}");
+                        negative_eta += 1;
+                    }
+                }
+            }
+            if !refused_bulk {
+                let (eo, ee) = material.indices(lambda, 0.0).unwrap();
+                let wi_v = Vector3::from(wi);
+                let s = Surface::new(
+                    re(ext_ior),
+                    Uniaxial::new(eo, ee, Vector3::from(axis)).unwrap(),
+                )
+                .unwrap();
+                let sum: f64 = crystal_slots(&s, wi_v, core_transport)
+                    .unwrap()
+                    .iter()
+                    .flatten()
+                    .map(|l| l.weight)
+                    .sum();
+                // Absorbing media: the per-wave power fractions leave out the interference terms
+                // of the flux (incident with reflected inside), so their sum has no bound (see
+                // `balance`); measured and reported, not asserted.
+                if importance && !lossless {
                     if sum > 1.0 + 1e-9 {
                         unbounded += 1;
                     }
                     let k = usize::from(wi[2] < 0.0);
                     max_unbounded[k] = max_unbounded[k].max(sum);
                 }
-                if bounded {
+                if importance && lossless {
                     if sum - 1.0 > worst_sum {
                         worst_sum = sum - 1.0;
-                        worst_sum_case =
-                            format!("crystal {desc:?} {g:?} wi {wi:?} lambda {lambda}");
+                        worst_sum_case = format!("crystal {case}");
                     }
-                    if lossless && !named && wi[2] > 0.0 && theta < 1.5 {
+                    if !named && wi[2] > 0.0 && theta < 1.5 {
                         lossless_sum_err = lossless_sum_err.max((sum - 1.0).abs());
                     }
                 }
             }
             // The band-filtered plate is evaluated only where (n_e − n_o) d <= 20 µm: beyond, a
             // known slowness of the core (seconds per call for strongly birefringent plates of
-            // millimetres at grazing incidence from below; see the report of issue 6) would
-            // dominate the run time. The exact plate (fwhm = 0) covers every thickness.
-            // (Named crystals: |n_e − n_o| <= 0.3 in the catalogue.)
-            let dn = if named {
-                0.3
-            } else {
-                (desc.eta_e.re - desc.eta_o.re).abs()
-            };
-            let band_ok = dn * g.thickness_nm <= 2e4;
-            for fwhm in [0.0, 4.0] {
+            // millimetres at grazing incidence from below) would dominate the run time. The
+            // exact plate covers every thickness. (Named crystals: |n_e − n_o| <= 0.3.)
+            let band_ok = dn * thickness_nm <= 2e4;
+            for (spectrum, fwhm) in [(&exact, 0.0), (&band, 4.0)] {
                 if fwhm > 0.0 && !band_ok {
                     continue;
                 }
                 let t0 = std::time::Instant::now();
-                let mut out = [BfrPathLobe::default(); 2];
-                let flags = BFR_WANT_REFLECTION | BFR_WANT_TRANSMISSION;
-                // SAFETY: as above.
-                let rc = unsafe {
-                    bfr_plate_lobes(
-                        m,
-                        &g,
-                        lambda,
-                        fwhm,
-                        wi.as_ptr(),
-                        transport,
-                        flags,
-                        out.as_mut_ptr(),
-                        msg.as_mut_ptr(),
-                        msg.len(),
-                    )
-                };
-                calls += 1;
+                for u in [0.2, 0.8] {
+                    let r = lane.run(u, Some((spectrum, exit_ior, thickness_nm)));
+                    calls += 1;
+                    let r = r.unwrap_or_else(|e| panic!("plate: {e} for {case} fwhm {fwhm}"));
+                    if let Some((_, _, m)) = r {
+                        let bound = if importance {
+                            1.0 + 1e-9
+                        } else {
+                            f64::INFINITY
+                        };
+                        worst_mueller = worst_mueller.max(mueller_violation(&m, bound));
+                    }
+                }
                 if t0.elapsed().as_secs_f64() > slowest {
                     slowest = t0.elapsed().as_secs_f64();
-                    slowest_case = format!(
-                        "named {named} {} {desc:?} {g:?} wi {wi:?} lambda {lambda} fwhm {fwhm}",
-                        NAMED[idx].0
-                    );
+                    slowest_case = format!("{case} fwhm {fwhm}");
                 }
-                let text = unsafe { std::ffi::CStr::from_ptr(msg.as_ptr()) }
-                    .to_string_lossy()
-                    .into_owned();
-                assert_eq!(
-                    rc, BFR_OK,
-                    "plate: {text} desc {desc:?} g {g:?} wi {wi:?} lambda {lambda} fwhm {fwhm}"
-                );
-                let mut sum = 0.0;
-                for l in out.iter().filter(|l| l.exists == 1) {
-                    let mm = Matrix4::from_row_slice(&l.mueller);
-                    let bound = if transport == BFR_IMPORTANCE {
-                        1.0 + 1e-9
-                    } else {
-                        f64::INFINITY
-                    };
-                    worst_mueller = worst_mueller.max(mueller_violation(&mm, bound));
-                    sum += l.weight;
+                if !importance {
+                    continue;
                 }
-                if transport == BFR_IMPORTANCE && fwhm == 0.0 && sum - 1.0 > worst_sum {
+                let q = PlateQuery::new(
+                    material,
+                    0.0,
+                    re(ext_ior),
+                    re(exit_ior),
+                    Vector3::from(axis),
+                    Thickness::from_nm(thickness_nm).unwrap(),
+                    true,
+                    true,
+                    false,
+                )
+                .unwrap();
+                let spec = Spectrum::Band {
+                    wavelength_nm: lambda,
+                    fwhm_nm: fwhm,
+                };
+                let lobes = plate_lobes(&q, &spec, Vector3::from(wi), core_transport).unwrap();
+                let sum: f64 = lobes[0].iter().flatten().map(|l| l.weight).sum();
+                if fwhm == 0.0 && sum - 1.0 > worst_sum {
                     worst_sum = sum - 1.0;
-                    worst_sum_case = format!("plate {desc:?} {g:?} wi {wi:?} lambda {lambda}");
+                    worst_sum_case = format!("plate {case}");
                 }
-                if transport == BFR_IMPORTANCE && fwhm > 0.0 && sum - 1.0 > worst_band {
+                if fwhm > 0.0 && sum - 1.0 > worst_band {
                     worst_band = sum - 1.0;
-                    worst_band_case =
-                        format!("plate fwhm {fwhm} {desc:?} {g:?} wi {wi:?} lambda {lambda}");
+                    worst_band_case = format!("plate fwhm {fwhm} {case}");
                 }
             }
         }
-        // SAFETY: created above, not used afterwards.
-        unsafe { bfr_material_free(m) };
     }
-    println!("C ABI: {calls} calls, all BFR_OK but {refused} absorbing bulk crystals refused as asked; worst Mueller violation {worst_mueller:.3e}");
+    println!("bridge: {calls} calls, all Ok but {refused} absorbing bulk crystals refused as asked; worst Mueller violation {worst_mueller:.3e}");
     assert!(refused > 100);
     println!(
-        "C ABI: slowest plate call {:.3} ms ({slowest_case})",
+        "bridge: slowest plate lane (2 calls) {:.3} ms ({slowest_case})",
         slowest * 1e3
     );
-    println!("C ABI: worst sum case: {worst_sum_case}");
+    println!("bridge: worst sum case: {worst_sum_case}");
     println!(
-        "C ABI: band-filtered plate (4 nm), worst R + T - 1 = {worst_band:.3e} ({worst_band_case})"
+        "bridge: band-filtered plate (4 nm), worst R + T - 1 = {worst_band:.3e} ({worst_band_case})"
     );
     println!(
-        "C ABI: absorbing isotropic media, Importance: {unbounded} calls with sum of weights > 1, largest {:.3} from outside, {:.3} from inside",
+        "bridge: absorbing isotropic media, Importance: {unbounded} cases with sum of weights > 1, largest {:.3} from outside, {:.3} from inside",
         max_unbounded[0], max_unbounded[1]
     );
-    println!("C ABI: lobes with eta < 0 (absorbing media only): {negative_eta}");
-    println!("C ABI: Importance mode, worst sum of weights - 1 = {worst_sum:.3e}");
-    println!("C ABI: lossless crystal from outside (theta < 1.5 rad): worst |sum - 1| = {lossless_sum_err:.3e}");
+    println!("bridge: sampled lobes with eta < 0 (absorbing media only): {negative_eta}");
+    println!("bridge: Importance mode, worst sum of weights - 1 = {worst_sum:.3e}");
+    println!("bridge: lossless crystal from outside (theta < 1.5 rad): worst |sum - 1| = {lossless_sum_err:.3e}");
     assert!(worst_mueller <= 1e-12, "{worst_mueller:e}");
     assert!(worst_sum <= 1e-9, "{worst_sum:e}");
     // The band-filtered plate is a closed-form approximation of the band average (Gaussian

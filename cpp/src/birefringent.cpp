@@ -84,7 +84,7 @@ double refraction needs a polarized variant; an isotropic material (``eta_o == e
         'optic_axis': [0.577, 0.577, 0.577],
         'optic_axis_space': 'world'
 */
-#include "common.h"
+#include "plugins.h"
 #include "last_valid.h"
 
 NAMESPACE_BEGIN(mitsuba)
@@ -94,15 +94,17 @@ class Birefringent final : public BSDF<Float, Spectrum> {
 public:
     MI_IMPORT_BASE(BSDF, m_flags, m_components)
     MI_IMPORT_TYPES()
-    using Lobes = bfr::Lobes<Float, Spectrum>;
+    using Answers = shim::Answers<Float, Spectrum>;
+    using Vec3d = typename Answers::Vec3d;
 
-    /// Wavelength (nm) used in the RGB variant, which has no wavelengths: only isotropic
-    /// constant indices are allowed there, so it does not matter.
-    static constexpr double RgbWavelength = 550.0;
+    /// Wavelength (nm) of the RGB and mono variants, which have none: there the crystal is
+    /// evaluated at this wavelength (only isotropic constant indices are allowed in the
+    /// unpolarised ones, where it does not matter).
+    static constexpr double FixedWavelength = 550.0;
 
     Birefringent(const Properties &props) : Base(props) {
-        m_params = bfr::parse_material(props, ClassName);
-        m_ext_ior = bfr::parse_ior(props, "ext_ior", "air", ClassName);
+        m_params = shim::parse_material(props, ClassName);
+        m_ext_ior = shim::parse_ior(props, "ext_ior", "air", ClassName);
         m_optic_axis = props.get<ScalarVector3f>("optic_axis", ScalarVector3f(1.f, 0.f, 0.f));
         std::string space = props.get<std::string>("optic_axis_space", "local");
         if (space != "local" && space != "world")
@@ -123,22 +125,23 @@ public:
     }
 
     /// Applies changed parameters; a rejected update leaves the last valid state in force
-    /// (bfr::update_or_restore).
+    /// (shim::update_or_restore).
     void parameters_changed(const std::vector<std::string> & /*keys*/ = {}) override {
-        bfr::update_or_restore<Float, Spectrum>(this, m_valid, [this] { rebuild(); });
+        shim::update_or_restore<Float, Spectrum>(this, m_valid, [this] { rebuild(); });
     }
 
 private:
     /// Rebuilds the core material and the flags, and checks every parameter with one core query.
     void rebuild() {
-        if (!is_polarized_v<Spectrum> && !m_params.isotropic())
+        m_material = shim::make_material(m_params, ClassName);
+        bool isotropic = m_material->is_isotropic(0);
+        if (!is_polarized_v<Spectrum> && !isotropic)
             Throw("double refraction (eta_o != eta_e, or a named crystal: %s) needs a polarized "
                   "variant, which carries whether a ray in the crystal is ordinary or "
-                  "extraordinary: use scalar_spectral_polarized (the llvm/cuda polarized "
-                  "variants are not supported). In this variant only an isotropic material "
+                  "extraordinary: use scalar_spectral_polarized, llvm_ad_spectral_polarized or "
+                  "llvm_ad_mono_polarized. In this variant only an isotropic material "
                   "(eta_o == eta_e, kappa_o == kappa_e) works.", m_params.to_string());
-        m_material = bfr::make_material(m_params, ClassName);
-        uint32_t aniso = m_params.isotropic() ? 0u : (uint32_t) BSDFFlags::Anisotropic;
+        uint32_t aniso = isotropic ? 0u : (uint32_t) BSDFFlags::Anisotropic;
         uint32_t sides = (uint32_t) (BSDFFlags::FrontSide | BSDFFlags::BackSide) | aniso;
         m_types[0] = BSDFFlags::DeltaReflection;
         m_types[1] = m_types[2] = BSDFFlags::DeltaTransmission;
@@ -148,32 +151,27 @@ private:
         // (n_wi / n_wo)^2 in its Radiance weight and not in its Importance weight:
         // non-symmetric, as Mitsuba's `dielectric` declares its refraction.
         for (size_t k = 0; k < 3; ++k) {
-            bool asym = k > 0 || !m_params.isotropic();
+            bool asym = k > 0 || !isotropic;
             m_components.push_back((uint32_t) m_types[k] | sides |
                                    (asym ? (uint32_t) BSDFFlags::NonSymmetric : 0u));
         }
         m_flags = m_components[0] | m_components[1] | m_components[2];
-
-        bfr_geometry g = geometry(m_optic_axis);
-        const double wi[3] = { 0.0, 0.0, 1.0 };
-        bfr_path_lobe out[BFR_CRYSTAL_LOBES];
-        char message[bfr::MessageLen] = { 0 };
-        int32_t rc = bfr_crystal_lobes(m_material.get(), &g, 550.0, wi, BFR_RADIANCE, out,
-                                       message, sizeof(message));
-        if (rc != BFR_OK)
-            Throw("%s", bfr::core_error(rc, message));
+        check_at_load();
     }
 
 public:
+
     std::pair<BSDFSample3f, Spectrum> sample(const BSDFContext &ctx, const SurfaceInteraction3f &si,
                                              Float sample1, const Point2f & /*sample2*/,
                                              Mask active) const override {
         MI_MASKED_FUNCTION(ProfilerPhase::BSDFSample, active);
-        constexpr size_t N = BFR_CRYSTAL_LOBES;
-        bfr_path_lobe lobes[Lobes::Channels * N];
-        if (!active || !query(si, ctx.mode, lobes))
+        uint32_t components = 0;
+        for (uint32_t k = 0; k < 3; ++k)
+            if (ctx.is_enabled(m_types[k], k))
+                components |= 1u << k;
+        if (!components || shim::none_active(active))
             return { dr::zeros<BSDFSample3f>(), dr::zeros<Spectrum>() };
-        return Lobes::sample(ctx, si, sample1, lobes, N, m_types, 3);
+        return query(si, ctx.mode, components, sample1, active);
     }
 
     Spectrum eval(const BSDFContext &, const SurfaceInteraction3f &, const Vector3f &,
@@ -183,7 +181,7 @@ public:
 
     Float pdf(const BSDFContext &, const SurfaceInteraction3f &, const Vector3f &,
               Mask) const override {
-        return 0.f;
+        return dr::zeros<Float>();
     }
 
     std::string to_string() const override {
@@ -200,57 +198,124 @@ public:
     MI_DECLARE_CLASS(Birefringent)
 
 private:
-    /// The core's geometry; `axis` in the local shading frame.
-    bfr_geometry geometry(const Vector3f &axis) const {
-        bfr_geometry g{};
-        g.ext_ior = m_ext_ior;
-        g.exit_ior = m_ext_ior;  // unused by the crystal
-        for (int k = 0; k < 3; ++k)
-            g.optic_axis[k] = axis[k];
-        return g;
+    /// Input columns of a core query (indices into shim::ChunkBuffers::in).
+    enum Column : size_t { AxisX, AxisY, AxisZ, WiX, WiY, WiZ, Sample, ExtIor, Wavelength0 };
+
+    /// One core query at normal incidence, 550 nm, with the axis as given; throws its message.
+    void check_at_load() const {
+        shim::ChunkBuffers<1> b;
+        const uint8_t one = 1;
+        const uint32_t material = 0;
+        const bfr::Transport radiance = bfr::Transport::Radiance;
+        const double u = 0.5;
+        bfr::CrystalLanes lanes{};
+        lanes.count = 1;
+        lanes.active = { &one, 1 };
+        lanes.material = { &material, 1 };
+        lanes.transport = { &radiance, 1 };
+        lanes.sample = { &u, 1 };
+        lanes.wi = { b.constant(WiX, 0.0).slice(), b.constant(WiY, 0.0).slice(),
+                     b.constant(WiZ, 1.0).slice() };
+        b.constant(Wavelength0, FixedWavelength);
+        lanes.wavelengths_nm = b.wavelength_columns(Wavelength0, 1);
+        lanes.ext_ior = b.constant(ExtIor, m_ext_ior).slice();
+        lanes.optic_axis = { b.constant(AxisX, m_optic_axis.x()).slice(),
+                             b.constant(AxisY, m_optic_axis.y()).slice(),
+                             b.constant(AxisZ, m_optic_axis.z()).slice() };
+        bfr::Samples s = b.samples(1, 1, true);
+        bfr::Status rc = bfr::sample_crystal(*m_material, 7u, lanes, s);
+        if (rc != bfr::Status::Ok)
+            Throw("%s", shim::core_message(rc, s.message));
     }
 
-    /// lobes[ch * BFR_CRYSTAL_LOBES + i]; false (after one warning) if the core refuses.
-    bool query(const SurfaceInteraction3f &si, TransportMode mode, bfr_path_lobe *lobes) const {
-        bfr_geometry g = geometry(m_axis_in_world ? si.to_local(m_optic_axis) : m_optic_axis);
-        const double wi[3] = { si.wi.x(), si.wi.y(), si.wi.z() };
-        int32_t transport = mode == TransportMode::Radiance ? BFR_RADIANCE : BFR_IMPORTANCE;
-        char message[bfr::MessageLen] = { 0 };
-        int32_t rc = BFR_OK;
+    /** The core's lobe for every lane of `si`, with the components in the bits of `components`
+     * enabled; lanes the core refuses carry no light and are reported once. */
+    std::pair<BSDFSample3f, Spectrum> query(const SurfaceInteraction3f &si, TransportMode mode,
+                                            uint32_t components, const Float &sample1,
+                                            const Mask &active) const {
+        shim::require_evaluated_mode<Float>(ClassName);
+        shim::HostInputs<Float> in;
+        size_t k_active = in.add_mask(active), k_u = in.add(sample1);
+        size_t k_wi[3] = { in.add(si.wi.x()), in.add(si.wi.y()), in.add(si.wi.z()) };
+        size_t k_axis = 0;
+        if (m_axis_in_world) {
+            Vector3f a = si.to_local(Vector3f(m_optic_axis));
+            k_axis = in.add(a.x());
+            in.add(a.y());
+            in.add(a.z());
+        }
+        size_t k_waves = 0, waves = 1;
         if constexpr (is_spectral_v<Spectrum>) {
-            for (size_t ch = 0; ch < Lobes::Channels && rc == BFR_OK; ++ch)
-                rc = bfr_crystal_lobes(m_material.get(), &g, (double) si.wavelengths[ch], wi,
-                                       transport, &lobes[ch * BFR_CRYSTAL_LOBES], message,
-                                       sizeof(message));
-        } else {  // RGB: isotropic constant indices only (checked at load), one query for all
-            rc = bfr_crystal_lobes(m_material.get(), &g, RgbWavelength, wi, transport, lobes,
-                                   message, sizeof(message));
-            for (size_t ch = 1; ch < Lobes::Channels; ++ch)
-                std::copy(lobes, lobes + BFR_CRYSTAL_LOBES, &lobes[ch * BFR_CRYSTAL_LOBES]);
+            waves = Answers::Channels;
+            for (size_t c = 0; c < waves; ++c) {
+                size_t k = in.add(si.wavelengths[c]);
+                k_waves = c == 0 ? k : k_waves;
+            }
         }
-        if (rc != BFR_OK) {
-            if (!m_warned.exchange(true))
-                Log(Warn, "%s (returning no light; further errors are not reported)",
-                    bfr::core_error(rc, message));
-            return false;
-        }
-        return true;
+        Answers answers;
+        size_t n = in.width();
+        answers.allocate(n);
+        in.read();
+
+        bool radiance = mode == TransportMode::Radiance;
+        bfr::Transport transport = radiance ? bfr::Transport::Radiance : bfr::Transport::Importance;
+        std::string failure = shim::for_chunks<Float>(n, [&](size_t begin, size_t end) {
+            shim::ChunkStorage<Float> storage;
+            auto &b = *storage;
+            const uint32_t material = 0;
+            bfr::CrystalLanes lanes{};
+            lanes.count = end - begin;
+            lanes.active = b.convert_mask(in.masks(k_active), begin, end);
+            lanes.material = { &material, 1 };
+            lanes.transport = { &transport, 1 };
+            lanes.sample = b.convert(Sample, in.floats(k_u), begin, end).slice();
+            lanes.wi = { b.convert(WiX, in.floats(k_wi[0]), begin, end).slice(),
+                         b.convert(WiY, in.floats(k_wi[1]), begin, end).slice(),
+                         b.convert(WiZ, in.floats(k_wi[2]), begin, end).slice() };
+            if constexpr (is_spectral_v<Spectrum>) {
+                for (size_t c = 0; c < waves; ++c)
+                    b.convert(Wavelength0 + c, in.floats(k_waves + c), begin, end);
+            } else {
+                b.constant(Wavelength0, FixedWavelength);
+            }
+            lanes.wavelengths_nm = b.wavelength_columns(Wavelength0, waves);
+            lanes.ext_ior = b.constant(ExtIor, m_ext_ior).slice();
+            if (m_axis_in_world)
+                lanes.optic_axis = { b.convert(AxisX, in.floats(k_axis), begin, end).slice(),
+                                     b.convert(AxisY, in.floats(k_axis + 1), begin, end).slice(),
+                                     b.convert(AxisZ, in.floats(k_axis + 2), begin, end).slice() };
+            else
+                lanes.optic_axis = { b.constant(AxisX, m_optic_axis.x()).slice(),
+                                     b.constant(AxisY, m_optic_axis.y()).slice(),
+                                     b.constant(AxisZ, m_optic_axis.z()).slice() };
+            bfr::Samples s = b.samples(lanes.count, waves, is_polarized_v<Spectrum>);
+            bfr::Status rc = bfr::sample_crystal(*m_material, components, lanes, s);
+            for (size_t j = 0; j < lanes.count; ++j) {
+                size_t i = begin + j;
+                Vec3d wi(in.floats(k_wi[0]).at(i), in.floats(k_wi[1]).at(i), in.floats(k_wi[2]).at(i));
+                answers.write(b, lanes.count, j, waves, wi, radiance, std::nullopt, m_types, i);
+            }
+            return rc == bfr::Status::Ok ? std::string() : shim::core_message(rc, s.message);
+        });
+        if (!failure.empty() && !m_warned.exchange(true))
+            Log(Warn, "%s (returning no light; further errors are not reported)", failure);
+        return answers.sample();
     }
 
-    bfr::MaterialParams m_params;
-    bfr::MaterialPtr m_material;
+    shim::MaterialParams m_params;
+    rust::Box<bfr::Materials> m_material = bfr::new_materials();
     double m_ext_ior;
     ScalarVector3f m_optic_axis;
     bool m_axis_in_world = false;
-    BSDFFlags m_types[3];
+    BSDFFlags m_types[(size_t) bfr::Bounds::CrystalComponents];
     mutable std::atomic<bool> m_warned { false };
-    std::unique_ptr<bfr::Snapshot<Float, Spectrum>> m_valid;  ///< last valid state
+    std::unique_ptr<shim::Snapshot<Float, Spectrum>> m_valid;  ///< last valid state
 
     MI_TRAVERSE_CB(Base)
 };
 
-NAMESPACE_BEGIN(bfr)
+NAMESPACE_BEGIN(shim)
 void register_birefringent() { register_plugin<Birefringent>("birefringent"); }
-NAMESPACE_END(bfr)
+NAMESPACE_END(shim)
 
 NAMESPACE_END(mitsuba)

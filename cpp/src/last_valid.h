@@ -3,7 +3,7 @@
  */
 #pragma once
 
-#include "common.h"
+#include "plugins.h"
 
 #include <drjit/tensor.h>
 
@@ -13,7 +13,7 @@
 #include <vector>
 
 NAMESPACE_BEGIN(mitsuba)
-NAMESPACE_BEGIN(bfr)
+NAMESPACE_BEGIN(shim)
 
 /** The values an object exposes to `mi.traverse`, its own and its textures' (recursively),
  * saved so that they can be put back: the last valid state of a plugin, restored when an
@@ -83,5 +83,5 @@ void update_or_restore(Object *self, std::unique_ptr<Snapshot<Float, Spectrum>> 
     valid = std::make_unique<Snapshot<Float, Spectrum>>(self);
 }
 
-NAMESPACE_END(bfr)
+NAMESPACE_END(shim)
 NAMESPACE_END(mitsuba)

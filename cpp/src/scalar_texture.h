@@ -4,10 +4,10 @@
  */
 #pragma once
 
-#include "common.h"
+#include "plugins.h"
 
 NAMESPACE_BEGIN(mitsuba)
-NAMESPACE_BEGIN(bfr)
+NAMESPACE_BEGIN(shim)
 
 /** A physical scalar that may vary over the surface (`thickness`, `birefringence`,
  * `axis_angle`), read with `eval_1` at each hit: a float, a uniform spectrum, a grey rgb (equal
@@ -76,5 +76,5 @@ ref<Texture<Float, Spectrum>> scalar_texture(const Properties &props, const std:
     return tex;
 }
 
-NAMESPACE_END(bfr)
+NAMESPACE_END(shim)
 NAMESPACE_END(mitsuba)

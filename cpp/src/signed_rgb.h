@@ -2,10 +2,10 @@
  * them.
  *
  * In scalar_rgb the plate's lobes are its spectra integrated over the linear sRGB (D65) channel
- * weights (bfr_plate_lobes_rgb). Where the plate's colour lies outside the sRGB gamut (saturated
- * interference colours) a channel is negative: that is the colour, the same linear sRGB value
- * Mitsuba's spectral variants accumulate for it (ImageBlock::put converts each spectral sample
- * with spectrum_to_srgb, signed and unclamped). The spectral variants' films do not check
+ * weights (the bridge's sRGB channel set). Where the plate's colour lies outside the sRGB gamut
+ * (saturated interference colours) a channel is negative: that is the colour, the same linear
+ * sRGB value Mitsuba's spectral variants accumulate for it (ImageBlock::put converts each
+ * spectral sample with spectrum_to_srgb, signed and unclamped). The spectral variants' films do not check
  * sample values (hdrfilm creates its blocks with warn_negative only in the non-spectral scalar
  * variants); the RGB variants' films do, because Mitsuba's own RGB BSDFs never go below zero,
  * so ImageBlock::put warns "Invalid sample value" for every such sample.
@@ -30,7 +30,7 @@
 #include <string_view>
 
 NAMESPACE_BEGIN(mitsuba)
-NAMESPACE_BEGIN(bfr)
+NAMESPACE_BEGIN(shim)
 
 /// True if `text` is ImageBlock's warning about a sample whose values are all finite and whose
 /// only negative values are among its first three (colour) channels.
@@ -150,5 +150,5 @@ private:
     bool m_active;
 };
 
-NAMESPACE_END(bfr)
+NAMESPACE_END(shim)
 NAMESPACE_END(mitsuba)

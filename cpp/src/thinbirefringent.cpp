@@ -127,7 +127,7 @@ evaluated with ``eval_1`` at the hit point (use ``raw="true"`` for data bitmaps)
         'optic_axis': [1, 1, 0],
         'thickness': 30.0
 */
-#include "common.h"
+#include "plugins.h"
 #include "last_valid.h"
 #include "scalar_texture.h"
 #include "signed_rgb.h"
@@ -139,28 +139,29 @@ class ThinBirefringent final : public BSDF<Float, Spectrum> {
 public:
     MI_IMPORT_BASE(BSDF, m_flags, m_components)
     MI_IMPORT_TYPES(Texture)
-    using Lobes = bfr::Lobes<Float, Spectrum>;
+    using Answers = shim::Answers<Float, Spectrum>;
+    using Vec3d = typename Answers::Vec3d;
 
     /// Default `filter_bandwidth` (nm, FWHM) of the spectral variants.
     static constexpr double DefaultFilterBandwidth = 0.0;
 
     ThinBirefringent(const Properties &props) : Base(props) {
-        m_params = bfr::parse_material(props, ClassName);
-        m_ext_ior = bfr::parse_ior(props, "ext_ior", "air", ClassName);
+        m_params = shim::parse_material(props, ClassName);
+        m_ext_ior = shim::parse_ior(props, "ext_ior", "air", ClassName);
         m_exit_ior = props.has_property("exit_ior")
-                         ? bfr::parse_ior(props, "exit_ior", "air", ClassName)
+                         ? shim::parse_ior(props, "exit_ior", "air", ClassName)
                          : m_ext_ior;
         m_optic_axis = props.get<ScalarVector3f>("optic_axis", ScalarVector3f(1.f, 0.f, 0.f));
-        m_thickness = bfr::scalar_texture<Float, Spectrum>(props, "thickness", 1.0,
-                                                           "micrometres", ClassName);
+        m_thickness = shim::scalar_texture<Float, Spectrum>(props, "thickness", 1.0,
+                                                            "micrometres", ClassName);
         m_thickness_scale = props.get<double>("thickness_scale", 1.0);
         if (props.has_property("birefringence"))
-            m_birefringence = bfr::scalar_texture<Float, Spectrum>(
+            m_birefringence = shim::scalar_texture<Float, Spectrum>(
                 props, "birefringence", 0.0, "added to eta_e", ClassName);
         m_birefringence_scale = props.get<double>("birefringence_scale", 1.0);
         if (props.has_property("axis_angle"))
-            m_axis_angle = bfr::scalar_texture<Float, Spectrum>(props, "axis_angle", 0.0,
-                                                                "degrees", ClassName);
+            m_axis_angle = shim::scalar_texture<Float, Spectrum>(props, "axis_angle", 0.0,
+                                                                 "degrees", ClassName);
         m_filter_bandwidth = props.get<double>("filter_bandwidth", DefaultFilterBandwidth);
         m_absorbing_exit = props.get<bool>("absorbing_exit", false);
         parameters_changed();
@@ -187,18 +188,26 @@ public:
     }
 
     /// Applies changed parameters; a rejected update leaves the last valid state in force
-    /// (bfr::update_or_restore).
+    /// (shim::update_or_restore).
     void parameters_changed(const std::vector<std::string> & /*keys*/ = {}) override {
-        bfr::update_or_restore<Float, Spectrum>(this, m_valid, [this] { rebuild(); });
+        shim::update_or_restore<Float, Spectrum>(this, m_valid, [this] { rebuild(); });
     }
 
 private:
-    /// Rebuilds the core material and the flags, and checks every parameter with one core query
-    /// (textures at their mean), so that invalid input fails here, with the core's message.
+    /// Rebuilds the core material, the spectrum and the flags, and checks every parameter with
+    /// one core query (textures at their mean, 550 nm, the filter band), so that invalid input
+    /// fails here, with the core's message.
     void rebuild() {
-        m_material = bfr::make_material(m_params, ClassName);
+        m_material = shim::make_material(m_params, ClassName);
+        m_band = bfr::band_spectrum(m_filter_bandwidth);
+        if constexpr (is_spectral_v<Spectrum>)
+            m_spectrum = bfr::band_spectrum(m_filter_bandwidth);
+        else
+            m_spectrum = bfr::channel_spectrum(is_rgb_v<Spectrum> ? bfr::ChannelSet::Srgb
+                                                                 : bfr::ChannelSet::Luminance);
         m_null = m_exit_ior == m_ext_ior && !m_absorbing_exit;
-        uint32_t aniso = (m_params.isotropic() && !m_birefringence) ? 0u : (uint32_t) BSDFFlags::Anisotropic;
+        bool isotropic = m_material->is_isotropic(0) && !m_birefringence;
+        uint32_t aniso = isotropic ? 0u : (uint32_t) BSDFFlags::Anisotropic;
         uint32_t sides = (uint32_t) (BSDFFlags::FrontSide | BSDFFlags::BackSide) | aniso;
         m_types[0] = BSDFFlags::DeltaReflection;
         m_types[1] = m_null ? BSDFFlags::Null : BSDFFlags::DeltaTransmission;
@@ -214,33 +223,20 @@ private:
             m_components.push_back((uint32_t) m_types[1] | sides | asym);
             m_flags = m_components[0] | m_components[1];
         }
-
-        bfr_geometry g;
-        std::string error;
-        if (!geometry(m_thickness->mean(), m_birefringence ? m_birefringence->mean() : 0.0,
-                      m_axis_angle ? m_axis_angle->mean() : 0.0, g, error))
-            Throw("%s", error);
-        const double wi[3] = { 0.0, 0.0, 1.0 };
-        bfr_path_lobe out[2];
-        char message[bfr::MessageLen] = { 0 };
-        int32_t rc = bfr_plate_lobes(m_material.get(), &g, 550.0, m_filter_bandwidth, wi,
-                                     BFR_RADIANCE, BFR_WANT_REFLECTION | BFR_WANT_TRANSMISSION,
-                                     out, message, sizeof(message));
-        if (rc != BFR_OK)
-            Throw("%s", bfr::core_error(rc, message));
+        check_at_load();
     }
 
 public:
+
     std::pair<BSDFSample3f, Spectrum> sample(const BSDFContext &ctx, const SurfaceInteraction3f &si,
                                              Float sample1, const Point2f & /*sample2*/,
                                              Mask active) const override {
         MI_MASKED_FUNCTION(ProfilerPhase::BSDFSample, active);
-        int32_t want = (ctx.is_enabled(m_types[0], 0) ? BFR_WANT_REFLECTION : 0) |
-                       (ctx.is_enabled(m_types[1], 1) ? BFR_WANT_TRANSMISSION : 0);
-        bfr_path_lobe lobes[Lobes::Channels * 2];
-        if (!active || !want || !query(si, ctx.mode, want, lobes))
+        uint32_t components = (ctx.is_enabled(m_types[0], 0) ? 1u : 0u) |
+                              (ctx.is_enabled(m_types[1], 1) ? 2u : 0u);
+        if (!components || shim::none_active(active))
             return { dr::zeros<BSDFSample3f>(), dr::zeros<Spectrum>() };
-        return Lobes::sample(ctx, si, sample1, lobes, 2, m_types, 2);
+        return query(si, ctx.mode, components, sample1, active, false).sample();
     }
 
     Spectrum eval(const BSDFContext &, const SurfaceInteraction3f &, const Vector3f &,
@@ -250,20 +246,15 @@ public:
 
     Float pdf(const BSDFContext &, const SurfaceInteraction3f &, const Vector3f &,
               Mask) const override {
-        return 0.f;
+        return dr::zeros<Float>();
     }
 
     /// The transmission matrix for light travelling along si.wi (shadow rays of volpath).
     Spectrum eval_null_transmission(const SurfaceInteraction3f &si, Mask active) const override {
         MI_MASKED_FUNCTION(ProfilerPhase::BSDFEvaluate, active);
-        bfr_path_lobe lobes[Lobes::Channels * 2];
-        if (!m_null || !active ||
-            !query(si, TransportMode::Radiance, BFR_WANT_TRANSMISSION, lobes))
+        if (!m_null || shim::none_active(active))
             return dr::zeros<Spectrum>();
-        int pick[Lobes::Channels];
-        for (size_t ch = 0; ch < Lobes::Channels; ++ch)
-            pick[ch] = lobes[ch * 2 + 1].exists ? 1 : -1;
-        return Lobes::spectrum(lobes, 2, pick, 1.0, si.wi, -si.wi, true);
+        return query(si, TransportMode::Radiance, 2u, Float(0.5f), active, true).spectrum();
     }
 
     std::string to_string() const override {
@@ -288,84 +279,157 @@ public:
     MI_DECLARE_CLASS(ThinBirefringent)
 
 private:
-    /// Geometry from the texture values: thickness (um, before scaling), birefringence (before
-    /// scaling), axis angle (degrees). False, with the message in `error`, if the angle is not
-    /// a finite number: the core sees only the rotated axis and would name `optic_axis`.
-    bool geometry(double thickness_um, double birefringence, double angle_deg, bfr_geometry &g,
-                  std::string &error) const {
-        if (!std::isfinite(angle_deg)) {
-            error = "axis_angle: must be a finite number (degrees), got " + std::to_string(angle_deg);
-            return false;
-        }
-        g = bfr_geometry{};
-        g.ext_ior = m_ext_ior;
-        g.exit_ior = m_exit_ior;
-        const double axis[3] = { m_optic_axis.x(), m_optic_axis.y(), m_optic_axis.z() };
-        bfr::rotate_about_normal(axis, angle_deg, g.optic_axis);
-        g.thickness_nm = 1000.0 * m_thickness_scale * thickness_um;
-        g.birefringence = m_birefringence_scale * birefringence;
-        return true;
+    /// Input columns of a core query (indices into shim::ChunkBuffers::in).
+    enum Column : size_t { Thickness, Birefringence, AxisX, AxisY, AxisZ, AxisAngle, WiX, WiY,
+                           WiZ, Sample, ExtIor, ExitIor, Wavelength0 };
+
+    /// The core's per-call settings.
+    bfr::PlateCall call(uint32_t components) const {
+        return { components, !is_polarized_v<Spectrum>, m_absorbing_exit };
     }
 
-    /// Core query at si: lobes[ch * 2 + i] for channel ch, lobe i (0 R, 1 T). False (after one
-    /// warning) if the core refuses, e.g. a texture gives a negative thickness.
-    bool query(const SurfaceInteraction3f &si, TransportMode mode, int32_t want,
-               bfr_path_lobe *lobes) const {
-        auto refuse = [this](const std::string &error) {
-            if (!m_warned.exchange(true))
-                Log(Warn, "%s (returning no light; further errors are not reported)", error);
-            return false;
-        };
-        bfr_geometry g;
-        std::string error;
-        if (!geometry(m_thickness->eval_1(si),
-                      m_birefringence ? (double) m_birefringence->eval_1(si) : 0.0,
-                      m_axis_angle ? (double) m_axis_angle->eval_1(si) : 0.0, g, error))
-            return refuse(error);
-        const double wi[3] = { si.wi.x(), si.wi.y(), si.wi.z() };
-        int32_t transport = mode == TransportMode::Radiance ? BFR_RADIANCE : BFR_IMPORTANCE;
-        int32_t flags = want | (is_polarized_v<Spectrum> ? 0 : BFR_INTENSITY_ONLY) |
-                        (m_absorbing_exit ? BFR_ABSORBING_EXIT : 0);
-        char message[bfr::MessageLen] = { 0 };
-        int32_t rc = BFR_OK;
-        if constexpr (is_rgb_v<Spectrum>) {
-            bfr_path_lobe rgb[3][2];
-            rc = bfr_plate_lobes_rgb(m_material.get(), &g, wi, transport, flags, rgb, message,
-                                     sizeof(message));
-            for (size_t ch = 0; ch < 3; ++ch)
-                for (size_t i = 0; i < 2; ++i)
-                    lobes[ch * 2 + i] = rgb[ch][i];
-        } else {
-            static_assert(Lobes::Channels <= BFR_MAX_BANDS, "one core query per path");
-            double waves[Lobes::Channels];
-            for (size_t ch = 0; ch < Lobes::Channels; ++ch)
-                waves[ch] = (double) si.wavelengths[ch];
-            rc = bfr_plate_lobes_n(m_material.get(), &g, waves, Lobes::Channels,
-                                   m_filter_bandwidth, wi, transport, flags, lobes, message,
-                                   sizeof(message));
-        }
-        if (rc != BFR_OK)
-            return refuse(bfr::core_error(rc, message));
-        return true;
+    /// One core query at normal incidence with the textures at their mean and the filter band
+    /// at 550 nm; throws its message.
+    void check_at_load() const {
+        shim::ChunkBuffers<1> b;
+        const uint8_t one = 1;
+        const uint32_t material = 0;
+        const bfr::Transport radiance = bfr::Transport::Radiance;
+        const double u = 0.5, lambda = 550.0;
+        rust::Slice<const double> wave(&lambda, 1);
+        bfr::PlateLanes lanes{};
+        lanes.count = 1;
+        lanes.active = { &one, 1 };
+        lanes.material = { &material, 1 };
+        lanes.transport = { &radiance, 1 };
+        lanes.sample = { &u, 1 };
+        lanes.wi = { b.constant(WiX, 0.0).slice(), b.constant(WiY, 0.0).slice(),
+                     b.constant(WiZ, 1.0).slice() };
+        lanes.wavelengths_nm = { &wave, 1 };
+        lanes.ext_ior = b.constant(ExtIor, m_ext_ior).slice();
+        lanes.exit_ior = b.constant(ExitIor, m_exit_ior).slice();
+        lanes.optic_axis = axis(b);
+        double angle = m_axis_angle ? shim::scalar(m_axis_angle->mean()) : 0.0;
+        lanes.axis_angle_deg = b.constant(AxisAngle, angle).slice();
+        double thickness = thickness_nm(shim::scalar(m_thickness->mean()));
+        lanes.thickness_nm = b.constant(Thickness, thickness).slice();
+        double dn = m_birefringence ? shim::scalar(m_birefringence->mean()) : 0.0;
+        lanes.birefringence = b.constant(Birefringence, m_birefringence_scale * dn).slice();
+        bfr::Samples s = b.samples(1, 1, true);
+        bfr::Status rc = bfr::sample_plate(*m_material, *m_band, call(3u), lanes, s);
+        if (rc != bfr::Status::Ok)
+            Throw("%s", shim::core_message(rc, s.message));
     }
 
-    bfr::MaterialParams m_params;
-    bfr::MaterialPtr m_material;
+    /// Thickness (nm) from the texture value (um, before scaling).
+    double thickness_nm(double thickness_um) const {
+        return 1000.0 * m_thickness_scale * thickness_um;
+    }
+
+    /** The core's lobe for every lane of `si`, with the components in the bits of `components`
+     * enabled. `straight`: the frames of a straight-through lobe (eval_null_transmission).
+     * Lanes the core refuses (e.g. a texture giving a negative thickness) carry no light and
+     * are reported once. */
+    Answers query(const SurfaceInteraction3f &si, TransportMode mode, uint32_t components,
+                  const Float &sample1, const Mask &active, bool straight) const {
+        shim::require_evaluated_mode<Float>(ClassName);
+        shim::HostInputs<Float> in;
+        size_t k_active = in.add_mask(active), k_u = in.add(sample1);
+        size_t k_wi[3] = { in.add(si.wi.x()), in.add(si.wi.y()), in.add(si.wi.z()) };
+        size_t k_thick = in.add(m_thickness->eval_1(si, active));
+        size_t k_biref = m_birefringence ? in.add(m_birefringence->eval_1(si, active)) : 0;
+        size_t k_angle = m_axis_angle ? in.add(m_axis_angle->eval_1(si, active)) : 0;
+        size_t k_waves = 0, waves = 0;
+        if constexpr (is_spectral_v<Spectrum>) {
+            waves = Answers::Channels;
+            for (size_t c = 0; c < waves; ++c) {
+                size_t k = in.add(si.wavelengths[c]);
+                k_waves = c == 0 ? k : k_waves;
+            }
+        }
+        Answers answers;
+        size_t n = in.width();
+        answers.allocate(n);
+        in.read();
+
+        bool radiance = mode == TransportMode::Radiance;
+        bfr::Transport transport = radiance ? bfr::Transport::Radiance : bfr::Transport::Importance;
+        bfr::PlateCall settings = call(components);
+        size_t channels = m_spectrum->channels(waves);
+        const shim::FloatColumn angle = m_axis_angle ? in.floats(k_angle) : shim::FloatColumn{};
+        std::string failure = shim::for_chunks<Float>(n, [&](size_t begin, size_t end) {
+            shim::ChunkStorage<Float> storage;
+            auto &b = *storage;
+            const uint32_t material = 0;
+            bfr::PlateLanes lanes{};
+            lanes.count = end - begin;
+            lanes.active = b.convert_mask(in.masks(k_active), begin, end);
+            lanes.material = { &material, 1 };
+            lanes.transport = { &transport, 1 };
+            lanes.sample = b.convert(Sample, in.floats(k_u), begin, end).slice();
+            lanes.wi = { b.convert(WiX, in.floats(k_wi[0]), begin, end).slice(),
+                         b.convert(WiY, in.floats(k_wi[1]), begin, end).slice(),
+                         b.convert(WiZ, in.floats(k_wi[2]), begin, end).slice() };
+            for (size_t c = 0; c < waves; ++c)
+                b.convert(Wavelength0 + c, in.floats(k_waves + c), begin, end);
+            lanes.wavelengths_nm = b.wavelength_columns(Wavelength0, waves);
+            lanes.ext_ior = b.constant(ExtIor, m_ext_ior).slice();
+            lanes.exit_ior = b.constant(ExitIor, m_exit_ior).slice();
+            lanes.optic_axis = axis(b);
+            lanes.axis_angle_deg = m_axis_angle
+                                       ? b.convert(AxisAngle, angle, begin, end).slice()
+                                       : b.constant(AxisAngle, 0.0).slice();
+            lanes.thickness_nm = b.convert(Thickness, in.floats(k_thick), begin, end,
+                                           [this](double t) { return thickness_nm(t); }).slice();
+            lanes.birefringence =
+                m_birefringence
+                    ? b.convert(Birefringence, in.floats(k_biref), begin, end,
+                                [this](double x) { return m_birefringence_scale * x; }).slice()
+                    : b.constant(Birefringence, 0.0).slice();
+            bfr::Samples s = b.samples(lanes.count, channels, is_polarized_v<Spectrum>);
+            bfr::Status rc = bfr::sample_plate(*m_material, *m_spectrum, settings, lanes, s);
+            for (size_t j = 0; j < lanes.count; ++j) {
+                size_t i = begin + j;
+                Vec3d wi(in.floats(k_wi[0]).at(i), in.floats(k_wi[1]).at(i), in.floats(k_wi[2]).at(i));
+                std::optional<Vec3d> through;
+                if (straight)
+                    through = -wi;
+                answers.write(b, lanes.count, j, channels, wi, radiance, through, m_types, i);
+            }
+            return rc == bfr::Status::Ok ? std::string() : shim::core_message(rc, s.message);
+        });
+        if (!failure.empty() && !m_warned.exchange(true))
+            Log(Warn, "%s (returning no light; further errors are not reported)", failure);
+        return answers;
+    }
+
+    /// The optic axis as given (the core rotates it by `axis_angle`).
+    template <size_t Cap>
+    std::array<rust::Slice<const double>, 3> axis(shim::ChunkBuffers<Cap> &b) const {
+        return { b.constant(AxisX, m_optic_axis.x()).slice(),
+                 b.constant(AxisY, m_optic_axis.y()).slice(),
+                 b.constant(AxisZ, m_optic_axis.z()).slice() };
+    }
+
+    shim::MaterialParams m_params;
+    rust::Box<bfr::Materials> m_material = bfr::new_materials();
+    rust::Box<bfr::PlateSpectrum> m_spectrum = bfr::exact_spectrum(), m_band = bfr::exact_spectrum();
     double m_ext_ior, m_exit_ior;
     ScalarVector3f m_optic_axis;
     ref<Texture> m_thickness, m_birefringence, m_axis_angle;
     double m_thickness_scale, m_birefringence_scale, m_filter_bandwidth;
     bool m_null = true, m_absorbing_exit = false;
-    BSDFFlags m_types[2];
+    BSDFFlags m_types[(size_t) bfr::Bounds::PlateComponents];
     mutable std::atomic<bool> m_warned { false };
-    bfr::SignedRgbGuard m_signed_rgb { is_rgb_v<Spectrum> };  ///< see signed_rgb.h
-    std::unique_ptr<bfr::Snapshot<Float, Spectrum>> m_valid;  ///< last valid state
+    /// See signed_rgb.h (the JIT variants' films do not warn of negative values).
+    shim::SignedRgbGuard m_signed_rgb { is_rgb_v<Spectrum> && !dr::is_jit_v<Float> };
+    std::unique_ptr<shim::Snapshot<Float, Spectrum>> m_valid;  ///< last valid state
 
     MI_TRAVERSE_CB(Base, m_thickness, m_birefringence, m_axis_angle)
 };
 
-NAMESPACE_BEGIN(bfr)
+NAMESPACE_BEGIN(shim)
 void register_thinbirefringent() { register_plugin<ThinBirefringent>("thinbirefringent"); }
-NAMESPACE_END(bfr)
+NAMESPACE_END(shim)
 
 NAMESPACE_END(mitsuba)

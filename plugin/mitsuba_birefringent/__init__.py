@@ -8,8 +8,9 @@ Importing the package registers both plugins with Mitsuba's plugin manager::
     mi.set_variant("scalar_spectral_polarized")
     plate = mi.load_dict({"type": "thinbirefringent", "material": "quartz", "thickness": 20.0})
 
-They work in the variants listed in :data:`VARIANTS` (the llvm/cuda variants raise a clear error
-at scene load). The optics is computed by the Rust core linked into the plugin library; see
+They work in the variants listed in :data:`VARIANTS` (the cuda variants raise a clear error at
+scene load); in the llvm variants, render inside :func:`evaluated_mode` (see its module,
+``jit``). The optics is computed by the Rust core linked into the plugin library; see
 ``plugin/README.md`` for the parameters. XML scenes render with the command
 ``mitsuba-birefringent`` (:mod:`mitsuba_birefringent.cli`); Mitsuba's own ``mitsuba`` command
 cannot load these plugins.
@@ -28,7 +29,10 @@ from pathlib import Path
 
 import mitsuba  # loads libmitsuba (and its PluginManager) before the plugin library
 
-__all__ = ["PLUGINS", "VARIANTS", "__version__", "library_path", "core_version", "register"]
+from .jit import evaluated_mode
+
+__all__ = ["PLUGINS", "VARIANTS", "__version__", "library_path", "core_version", "register",
+           "evaluated_mode"]
 
 try:
     #: The installed distribution's version (Cargo.toml's, written by the build backend).
@@ -39,9 +43,6 @@ except importlib.metadata.PackageNotFoundError:
 
 #: The BSDF plugin names this package registers.
 PLUGINS = ("thinbirefringent", "birefringent")
-
-#: The Mitsuba variants the plugins work in.
-VARIANTS = ("scalar_rgb", "scalar_spectral", "scalar_spectral_polarized")
 
 _LIBRARY_NAME = "libmitsuba_birefringent.so"
 _lib = None
@@ -68,8 +69,9 @@ def _load() -> ctypes.CDLL:
         lib = ctypes.CDLL(str(path), mode=ctypes.RTLD_GLOBAL)
         lib.bfr_mitsuba_register.argtypes = [ctypes.c_char_p, ctypes.c_size_t]
         lib.bfr_mitsuba_register.restype = ctypes.c_int
-        lib.bfr_mitsuba_version.argtypes = []
-        lib.bfr_mitsuba_version.restype = ctypes.c_char_p
+        for name in ("bfr_mitsuba_version", "bfr_mitsuba_variants"):
+            getattr(lib, name).argtypes = []
+            getattr(lib, name).restype = ctypes.c_char_p
         _lib = lib
     return _lib
 
@@ -89,3 +91,6 @@ def core_version() -> str:
 
 
 register()
+
+#: The Mitsuba variants the plugins work in (as the plugin library registers them).
+VARIANTS = tuple(_load().bfr_mitsuba_variants().decode().split(", "))

@@ -10,7 +10,8 @@ command takes the options of ``mitsuba`` 3.9.1 with the same meaning::
 and renders each scene with its own integrator, writing the film of the chosen sensor (by
 default next to the scene file, with the film's extension, as ``mitsuba`` does). One option is
 added: ``--spp N`` overrides the sampler's sample count. ``-V`` (the LLVM vector width) is not
-supported.
+supported. In the llvm variants scenes render in Dr.Jit's evaluated mode, which the plugins
+need (``mitsuba_birefringent.evaluated_mode``).
 """
 
 from __future__ import annotations
@@ -119,7 +120,8 @@ def render_file(path: Path, params: dict[str, str], args: argparse.Namespace) ->
     integrator = scene.integrator()
     if integrator is None:
         raise ValueError(f"{path}: the scene has no integrator")
-    with thread_count(args.threads):
+    # The plugins need Dr.Jit's evaluated mode in the JIT variants (no-op in scalar ones).
+    with thread_count(args.threads), mitsuba_birefringent.evaluated_mode():
         integrator.render(scene, sensor=args.sensor, seed=0, spp=args.spp or 0, develop=False,
                           evaluate=True)
     sensors[args.sensor].film().write(str(args.output or path))

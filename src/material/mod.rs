@@ -141,6 +141,12 @@ impl Material {
         self.eta_o.is_dispersive() || self.eta_e.is_dispersive()
     }
 
+    /// True if the material is isotropic at every wavelength: equal constant indices (named
+    /// crystals are birefringent).
+    pub fn is_isotropic(&self) -> bool {
+        matches!((self.eta_o, self.eta_e), (Index::Constant(o), Index::Constant(e)) if o == e)
+    }
+
     /// The named crystals of this material (each once).
     fn crystals(&self) -> Vec<&'static Crystal> {
         let mut v: Vec<&'static Crystal> = Vec::new();

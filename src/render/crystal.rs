@@ -20,6 +20,7 @@ use crate::optics::modes::ModeKind;
 use crate::optics::mueller::reversed;
 use crate::optics::surface::{Incident, Surface};
 use crate::render::isotropic;
+use crate::render::slots::{crystal_slot, Slots, CRYSTAL_SLOTS};
 use crate::render::{PathLobe, Transport};
 use nalgebra::Vector3;
 
@@ -67,6 +68,21 @@ pub fn crystal_lobes(
     wi: Vector3<f64>,
     transport: Transport,
 ) -> Result<Vec<PathLobe>> {
+    refuse_absorbing_birefringence(surface)?;
+    let Some(wi) = checked_direction(wi)? else {
+        return Ok(Vec::new());
+    };
+    if let Some(lobes) = isotropic::crystal_lobes(surface, wi, transport) {
+        return Ok(lobes);
+    }
+    let mut lobes = Vec::new();
+    each_lobe(surface, wi, transport, |_, l| lobes.push(l))?;
+    Ok(lobes)
+}
+
+/// Absorbing anisotropic crystals are refused (see [`crystal_lobes`]), naming the absorbing
+/// index's parameter.
+fn refuse_absorbing_birefringence(surface: &Surface) -> Result<()> {
     if !surface.crystal.is_isotropic() && !surface.crystal.is_lossless() {
         let absorbing = if surface.crystal.eta_o.im != 0.0 {
             "kappa_o"
@@ -78,13 +94,7 @@ pub fn crystal_lobes(
             "an absorbing birefringent crystal cannot be rendered as a bulk surface: inside it the o and e waves are not power-orthogonal (their fluxes do not add), so the power of each refracted ray is undefined and lobe weights would not conserve energy. Use thinbirefringent for a dichroic plate (its transmission is exact), or kappa_o = kappa_e = 0 here",
         ));
     }
-    let Some(wi) = checked_direction(wi)? else {
-        return Ok(Vec::new());
-    };
-    if let Some(lobes) = isotropic::crystal_lobes(surface, wi, transport) {
-        return Ok(lobes);
-    }
-    crystal_lobes_full(surface, wi, transport)
+    Ok(())
 }
 
 /// `wi` normalised, `None` at exactly grazing incidence (no lobes); an error unless unit.
@@ -105,35 +115,92 @@ pub fn crystal_lobes_full(
     let Some(wi) = checked_direction(wi)? else {
         return Ok(Vec::new());
     };
+    let mut lobes = Vec::new();
+    each_lobe(surface, wi, transport, |_, l| lobes.push(l))?;
+    Ok(lobes)
+}
+
+/// The lobes of [`crystal_lobes`] in their fixed slots ([`crate::render::slots`]): the same
+/// lobes, bit for bit, each at the index of the two waves it joins.
+pub fn crystal_slots(
+    surface: &Surface,
+    wi: Vector3<f64>,
+    transport: Transport,
+) -> Result<Slots<CRYSTAL_SLOTS>> {
+    let mut slots = [None; CRYSTAL_SLOTS];
+    refuse_absorbing_birefringence(surface)?;
+    let Some(wi) = checked_direction(wi)? else {
+        return Ok(slots);
+    };
+    if let Some(lobes) = isotropic::crystal_lobes(surface, wi, transport) {
+        // Reflection (component 0) and refraction (1) of an isotropic crystal, whose rays
+        // count as o-rays.
+        let crystal = Some(ModeKind::O);
+        let (near, far) = if wi.z < 0.0 {
+            (crystal, None)
+        } else {
+            (None, crystal)
+        };
+        for l in lobes {
+            let wo_end = if l.component == 0 { near } else { far };
+            slots[crystal_slot(near, wo_end)] = Some(l);
+        }
+        return Ok(slots);
+    }
+    each_lobe(surface, wi, transport, |slot, l| slots[slot] = Some(l))?;
+    Ok(slots)
+}
+
+/// Calls `f(slot, lobe)` for every lobe seen from `wi` (unit, `wi.z != 0`), by the general
+/// computation.
+fn each_lobe(
+    surface: &Surface,
+    wi: Vector3<f64>,
+    transport: Transport,
+    mut f: impl FnMut(usize, PathLobe),
+) -> Result<()> {
     let opaque = opaque(surface);
     if wi.z < 0.0 && opaque {
-        return Ok(Vec::new()); // no light inside an opaque bulk
+        return Ok(()); // no light inside an opaque bulk
     }
-    let mut lobes = Vec::new();
     for (inc, event) in forward_events(surface, wi)? {
         for (component, l) in outgoing(&event, inc) {
             if opaque && component != 0 {
                 continue; // refracted into the opaque bulk: absorbed at the surface
             }
+            // The crystal mode of the outgoing wave (None outside): a reflection stays on the
+            // incident side; a transmission from outside enters as its own mode.
+            let mode = match (component, inc) {
+                (0, inc) => inc.map(|_| l.kind),
+                (_, None) => Some(l.kind),
+                (_, Some(_)) => None,
+            };
+            let slot = crystal_slot(inc, mode);
             match transport {
-                Transport::Importance => lobes.push(PathLobe::new(
-                    component,
-                    l.direction,
-                    (event.incident_stokes_x, l.stokes_x),
-                    l.mueller,
-                    l.ray_index / event.incident_ray_index,
-                )),
-                Transport::Radiance => lobes.push(PathLobe::new(
-                    component,
-                    l.direction,
-                    (l.stokes_x, event.incident_stokes_x),
-                    reversed(&l.mueller) * (event.incident_ray_index / l.ray_index).powi(2),
-                    l.ray_index / event.incident_ray_index,
-                )),
+                Transport::Importance => f(
+                    slot,
+                    PathLobe::new(
+                        component,
+                        l.direction,
+                        (event.incident_stokes_x, l.stokes_x),
+                        l.mueller,
+                        l.ray_index / event.incident_ray_index,
+                    ),
+                ),
+                Transport::Radiance => f(
+                    slot,
+                    PathLobe::new(
+                        component,
+                        l.direction,
+                        (l.stokes_x, event.incident_stokes_x),
+                        reversed(&l.mueller) * (event.incident_ray_index / l.ray_index).powi(2),
+                        l.ray_index / event.incident_ray_index,
+                    ),
+                ),
             }
         }
     }
-    Ok(lobes)
+    Ok(())
 }
 
 /// Whether the crystal's bulk is opaque (any absorption): light refracted into it is absorbed

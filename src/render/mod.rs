@@ -9,9 +9,11 @@
 //! they are the reversed outgoing rays of a wave sent along `−wi`; for each, the forward
 //! problem is then solved from that source and the outgoing wave along `wi` is kept.
 
+pub mod choice;
 pub mod crystal;
 pub mod isotropic;
 pub mod plate;
+pub mod slots;
 
 use nalgebra::{Matrix4, Vector3};
 

@@ -17,7 +17,7 @@
 # committed), seeded from tests/fuzz/corpus/TARGET (committed); crashing, timing-out or
 # memory-hungry inputs are written to target/fuzz/artifacts/TARGET/ and the script exits 1
 # (slow inputs are kept there too, as timeout-*, and listed; see the libFuzzer options below).
-# Inputs that break only the soft contract (the core's *internal* error, BFR_INTERNAL or "a bug:
+# Inputs that break only the soft contract (the core's *internal* error, Status::Internal or "a bug:
 # please report the input": a clean error status, no non-finite number handed out, but a core
 # defect; or a finite power fraction above 1) are kept in target/fuzz/findings/TARGET/ and
 # listed; FUZZ_STRICT=1 (which `make test` sets) turns them into crashes: the run fails and the
@@ -32,7 +32,7 @@ shift
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(c_abi calc_json calc_fields)
+[ ${#targets[@]} -gt 0 ] || targets=(bridge calc_json calc_fields)
 cargo=${CARGO:-$(command -v cargo || echo "$HOME/.cargo/bin/cargo")}
 rustc=$(dirname "$cargo")/rustc
 [ -x "$rustc" ] || rustc=rustc

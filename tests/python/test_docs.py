@@ -19,8 +19,8 @@ DOCS = ROOT / "docs"
 
 #: The modules docs/architecture.md must map: the core, the ABI header, the shim, the package
 #: and its build backend.
-MODULE_GLOBS = ("src/**/*.rs", "cpp/include/*.h", "cpp/src/*", "plugin/mitsuba_birefringent/*.py",
-                "build_backend/*.py")
+MODULE_GLOBS = ("src/**/*.rs", "build.rs", "cpp/build.rs", "cpp/src/*",
+                "plugin/mitsuba_birefringent/*.py", "build_backend/*.py")
 #: Where citations of docs/ are looked for.
 CITING = ("src", "tests", "cpp", "plugin", "scenes", "tools", "bench", "examples", "build_backend",
           "docs", "Makefile", "README.md", "pyproject.toml")
@@ -86,8 +86,8 @@ def source_names(path: pathlib.Path) -> tuple[set[str], set[str]]:
     source = path.read_text()
     read = r'(?:props\.\w+(?:<[^>]*>)?\(|(?:parse_ior|scalar_texture<[^>]*>)\(\s*props,\s*)\s*"(\w+)"'
     names = set(re.findall(read, source))
-    if "parse_material(props" in source:  # common.h reads the material properties
-        common = (path.parent / "common.h").read_text()
+    if "parse_material(props" in source:  # params.h reads the material properties
+        common = (path.parent / "params.h").read_text()
         body = common[common.index("inline MaterialParams parse_material"):]
         names |= set(re.findall(read, body[:body.index("\n}\n")]))
     exposed = set(re.findall(r'cb->put\("(\w+)"', source))

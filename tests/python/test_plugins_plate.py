@@ -440,8 +440,8 @@ def test_render_through_a_null_plate():
 
 
 def test_unpolarized_variants_give_the_polarized_m00():
-    """scalar_spectral returns M00 of the polarized variant's Mueller matrix (same core, flag
-    BFR_INTENSITY_ONLY)."""
+    """scalar_spectral returns M00 of the polarized variant's Mueller matrix (same core, the
+    bridge's intensity-only query)."""
     kw = dict(material="calcite", thickness=4.0, optic_axis=[0.3, 0.5, 0.81], filter_bandwidth=0.0)
     dirs = random_directions(40, seed=21)
     results = {}
@@ -472,7 +472,7 @@ def test_invalid_texture_value_at_render_time_gives_no_light():
 def srgb_d65_reference(kw, wi, mode, component, step=0.5):
     """Linear sRGB (D65) channel values of the exact plate's M00, by quadrature over 360-830 nm
     with Mitsuba's CIE 1931 matching functions and D65 spectrum, each channel normalised so
-    that a flat response of 1 gives 1 (the contract of bfr_plate_lobes_rgb)."""
+    that a flat response of 1 gives 1 (the contract of the bridge's sRGB channel set)."""
     variant("scalar_spectral")
     exact = plate(filter_bandwidth=0.0, **kw)
     d65 = mi.load_dict({"type": "d65"})

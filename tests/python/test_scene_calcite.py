@@ -56,9 +56,12 @@ def test_calcite_slab_doubles_a_dot_with_orthogonal_polarisations():
     for p in pol:
         assert abs(abs(p[0]) - 1.0) < 1e-3 and abs(p[1]) < 1e-3 and abs(p[2]) < 1e-3, pol
     assert pol[0][0] * pol[1][0] < 0
-    # The ordinary image sits on the dot (image centre); the other is shifted by t tan(rho).
-    offsets = sorted(centroids, key=lambda c: abs(c - W / 2))
-    assert abs(offsets[0] - W / 2) < 0.5, centroids
+    # The ordinary image sits on the dot (image centre); the other is shifted by t tan(rho). In
+    # pixel indices (pixel i covers [i, i + 1)) the centre of the image is at W / 2 - 0.5; the
+    # centroid's noise is ~0.06 px (measured over 8 seeds: 99.44-99.63).
+    centre = W / 2 - 0.5
+    offsets = sorted(centroids, key=lambda c: abs(c - centre))
+    assert abs(offsets[0] - centre) < 0.3, centroids
     expected = THICKNESS * math.tan(walk_off(1.6584, 1.4864, TILT)) * W / 1.0
     measured = abs(offsets[1] - offsets[0])
     # Tolerance: calcite's dispersion moves the walk-off by ~±0.3 px over the visible (the render

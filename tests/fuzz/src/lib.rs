@@ -64,6 +64,11 @@ impl<'a> Bytes<'a> {
         self.pos >= self.data.len()
     }
 
+    /// The bytes not read yet.
+    pub fn rest(&self) -> &'a [u8] {
+        &self.data[self.pos.min(self.data.len())..]
+    }
+
     pub fn u8(&mut self) -> u8 {
         let b = self.data.get(self.pos).copied().unwrap_or(0);
         self.pos += 1;
@@ -424,7 +429,7 @@ pub fn set_input(data: &[u8]) {
 }
 
 /// A breach of the *soft* contract: an entry point answered with its internal error
-/// (`BFR_INTERNAL`, or the calculator's "a bug: please report the input": a clean error status
+/// (`Status::Internal` of the bridge, or the calculator's "a bug: please report the input": a clean error status
 /// with no non-finite number handed out, so the brief's contract of no crash and finite output
 /// or a clean error holds, but it is a core defect), or a finite result outside its physical
 /// bounds (a power fraction above 1). With `FUZZ_STRICT=1` it is a crash (libFuzzer keeps the

@@ -1,0 +1,81 @@
+//! The plugin library's C entry points, called by the Python package (`ctypes`): registration
+//! of the Mitsuba plugins (the C++ shim of this crate), the version and the supported variants.
+//! Everything else the shim needs from the core goes through the core's bridge.
+
+use std::ffi::{c_char, CStr};
+use std::sync::OnceLock;
+
+// The shim calls the core's bridge: link it.
+use birefringent as _;
+
+#[cxx::bridge(namespace = "bfr")]
+mod shim {
+    unsafe extern "C++" {
+        include!("register.h");
+
+        /// Registers both plugins with Mitsuba's PluginManager.
+        fn register_plugins() -> Result<()>;
+
+        /// The variants the plugins work in, comma-separated.
+        fn supported_variants() -> &'static str;
+    }
+}
+
+/// Writes `msg` into the caller's buffer (NUL-terminated, truncated to fit).
+///
+/// # Safety
+/// `buf` is null or points to `len` writable bytes.
+unsafe fn write_message(msg: &str, buf: *mut c_char, len: usize) {
+    if buf.is_null() || len == 0 {
+        return;
+    }
+    let n = msg.len().min(len - 1);
+    // SAFETY: the caller guarantees `buf` points to `len` writable bytes.
+    unsafe {
+        std::ptr::copy_nonoverlapping(msg.as_ptr() as *const c_char, buf, n);
+        *buf.add(n) = 0;
+    }
+}
+
+/// Registers `thinbirefringent` and `birefringent` (again: a new registration replaces the
+/// old). Returns 0, or 1 with a message in `message` (`message_len` bytes).
+///
+/// # Safety
+/// `message` is null or points to `message_len` writable bytes.
+#[no_mangle]
+pub unsafe extern "C" fn bfr_mitsuba_register(message: *mut c_char, message_len: usize) -> i32 {
+    let outcome = std::panic::catch_unwind(shim::register_plugins);
+    let text = match outcome {
+        Ok(Ok(())) => return 0,
+        Ok(Err(e)) => e.what().to_string(),
+        Err(_) => "internal error (panic caught) while registering the plugins".to_string(),
+    };
+    // SAFETY: the caller's contract.
+    unsafe { write_message(&text, message, message_len) };
+    1
+}
+
+/// A static NUL-terminated copy of `text`.
+fn c_string(cell: &'static OnceLock<Vec<u8>>, text: impl FnOnce() -> String) -> *const c_char {
+    let bytes = cell.get_or_init(|| {
+        let mut v = text().into_bytes();
+        v.retain(|&b| b != 0);
+        v.push(0);
+        v
+    });
+    CStr::from_bytes_with_nul(bytes).map_or(std::ptr::null(), CStr::as_ptr)
+}
+
+/// The core's version (static, NUL-terminated).
+#[no_mangle]
+pub extern "C" fn bfr_mitsuba_version() -> *const c_char {
+    static CELL: OnceLock<Vec<u8>> = OnceLock::new();
+    c_string(&CELL, || birefringent::ffi::version().to_string())
+}
+
+/// The variants the plugins work in, comma-separated (static, NUL-terminated).
+#[no_mangle]
+pub extern "C" fn bfr_mitsuba_variants() -> *const c_char {
+    static CELL: OnceLock<Vec<u8>> = OnceLock::new();
+    c_string(&CELL, || shim::supported_variants().to_string())
+}

@@ -1,0 +1,100 @@
+/* Scene parameters shared by the two plugins: the material (a named crystal or constant
+ * indices, as the core's material table takes them), indices of refraction by number or by
+ * Mitsuba's IOR names. Values are checked by the core (its messages name the parameter), not
+ * here.
+ */
+#pragma once
+
+#include <mitsuba/core/properties.h>
+#include <mitsuba/render/ior.h>
+
+#include <cmath>
+#include <sstream>
+#include <string>
+
+#include "rust/cxx.h"
+#include "birefringent/src/ffi/mod.rs.h"
+
+NAMESPACE_BEGIN(mitsuba)
+NAMESPACE_BEGIN(shim)
+
+/// The material parameters as given in the scene description.
+struct MaterialParams {
+    bool named = true;     ///< a named crystal (`material`), else constant indices
+    std::string material;  ///< the crystal's name as given (the core refuses an unknown one)
+    double eta_o = 0, eta_e = 0, kappa_o = 0, kappa_e = 0;
+
+    std::string to_string() const {
+        std::ostringstream oss;
+        if (named)
+            oss << "material = \"" << material << "\", ";
+        else
+            oss << "eta_o = " << eta_o << ", eta_e = " << eta_e << ", ";
+        oss << "kappa_o = " << kappa_o << ", kappa_e = " << kappa_e;
+        return oss.str();
+    }
+};
+
+/* The functions below take `ClassName` as a parameter so that Mitsuba's Throw/Log macros, which
+   refer to a variable of that name, tag their messages with the plugin's class. */
+
+/// `material` (string) or `eta_o` + `eta_e` (floats); `kappa_o`, `kappa_e` (floats, default 0).
+/// Without either, the material is "calcite".
+inline MaterialParams parse_material(const Properties &props, const char *ClassName) {
+    MaterialParams m;
+    bool has_o = props.has_property("eta_o"), has_e = props.has_property("eta_e");
+    if (props.has_property("material") && (has_o || has_e))
+        Throw("give either \"material\" or \"eta_o\" and \"eta_e\", not both");
+    if (has_o != has_e)
+        Throw("\"%s\" is missing (\"%s\" is given): give both eta_o and eta_e, or \"material\"",
+              has_o ? "eta_e" : "eta_o", has_o ? "eta_o" : "eta_e");
+    if (has_o) {
+        m.named = false;
+        m.eta_o = props.get<double>("eta_o");
+        m.eta_e = props.get<double>("eta_e");
+    } else {
+        m.material = props.get<std::string>("material", "calcite");
+    }
+    m.kappa_o = props.get<double>("kappa_o", 0.0);
+    m.kappa_e = props.get<double>("kappa_e", 0.0);
+    return m;
+}
+
+/// The core's one-material table (index 0); throws the core's message (it names the
+/// parameter).
+inline rust::Box<bfr::Materials> make_material(const MaterialParams &p, const char *ClassName) {
+    rust::Box<bfr::Materials> table = bfr::new_materials();
+    try {
+        if (p.named)
+            table->add_named(p.material, p.kappa_o, p.kappa_e);
+        else
+            table->add_constant(p.eta_o, p.eta_e, p.kappa_o, p.kappa_e);
+    } catch (const std::exception &e) {  // rust::Error, or a name that is not UTF-8
+        Throw("%s", e.what());
+    }
+    std::string warning(table->warning(0));
+    if (!warning.empty())
+        Log(Warn, "%s", warning);
+    return table;
+}
+
+/// An index of refraction: a number, or one of Mitsuba's IOR names (`lookup_ior`).
+inline double parse_ior(const Properties &props, const std::string &name,
+                        const std::string &default_name, const char *ClassName) {
+    if (props.has_property(name)) {
+        auto type = props.type(name);
+        if (type == Properties::Type::Float || type == Properties::Type::Integer)
+            return props.get<double>(name);
+        if (type != Properties::Type::String)
+            Throw("\"%s\" must be a float (a real index) or one of Mitsuba's IOR names (e.g. "
+                  "\"water\"), got %s", name, property_type_name(type));
+    }
+    try {
+        return (double) lookup_ior(props, name, default_name);
+    } catch (const std::exception &e) {
+        Throw("\"%s\": %s", name, e.what());
+    }
+}
+
+NAMESPACE_END(shim)
+NAMESPACE_END(mitsuba)

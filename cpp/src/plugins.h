@@ -1,0 +1,76 @@
+/* What both plugins include: the parameters, the bridge to the core, the conversion of its
+ * lobes, and their registration with Mitsuba's PluginManager in the supported variants.
+ */
+#pragma once
+
+#include <mitsuba/core/plugin.h>
+#include <mitsuba/core/string.h>
+#include <mitsuba/render/bsdf.h>
+#include <mitsuba/render/texture.h>
+
+#include <atomic>
+#include <optional>
+#include <sstream>
+#include <string>
+
+#include "bridge.h"
+#include "lobes.h"
+#include "params.h"
+
+NAMESPACE_BEGIN(mitsuba)
+NAMESPACE_BEGIN(shim)
+
+/// The variants the plugins work in, comma-separated.
+constexpr const char *SupportedVariants =
+    "scalar_rgb, scalar_spectral, scalar_spectral_polarized, llvm_ad_rgb, llvm_ad_mono, "
+    "llvm_ad_mono_polarized, llvm_ad_spectral, llvm_ad_spectral_polarized";
+
+/// Registers `Plugin<Float, Spectrum>` as `name` in `variant`.
+template <template <typename, typename> class Plugin, typename Float, typename Spectrum>
+void register_variant(PluginManager *pm, const char *name, const char *variant) {
+    pm->register_plugin(name, variant, ObjectType::BSDF,
+        [](void *, const Properties &p) -> ref<Object> { return new Plugin<Float, Spectrum>(p); },
+        nullptr, nullptr);
+}
+
+/// Registers `name` in a CUDA variant with a constructor that refuses it with a clear message:
+/// the core runs on the CPU, so a CUDA variant would need a device-host round trip per query.
+inline void register_refusal(PluginManager *pm, const char *name, const char *variant) {
+    pm->register_plugin(name, variant, ObjectType::BSDF,
+        [](void *payload, const Properties &p) -> ref<Object> {
+            std::string v = (const char *) payload;
+            throw std::runtime_error(
+                std::string(p.plugin_name()) + ": variant \"" + v + "\" is not supported (the "
+                "birefringent core computes on the CPU); use \"llvm" + v.substr(4) + "\", or any of " +
+                SupportedVariants);
+        },
+        nullptr, (void *) variant);
+}
+
+/// The plugin in every supported variant; the CUDA ones get a constructor with a clear error.
+template <template <typename, typename> class Plugin> void register_plugin(const char *name) {
+    PluginManager *pm = PluginManager::instance();
+    register_variant<Plugin, float, Color<float, 3>>(pm, name, "scalar_rgb");
+    register_variant<Plugin, float, Spectrum<float, 4>>(pm, name, "scalar_spectral");
+    register_variant<Plugin, float, MuellerMatrix<Spectrum<float, 4>>>(pm, name,
+                                                                       "scalar_spectral_polarized");
+    using FloatL = dr::DiffArray<JitBackend::LLVM, float>;
+    register_variant<Plugin, FloatL, Color<FloatL, 3>>(pm, name, "llvm_ad_rgb");
+    register_variant<Plugin, FloatL, Color<FloatL, 1>>(pm, name, "llvm_ad_mono");
+    register_variant<Plugin, FloatL, MuellerMatrix<Color<FloatL, 1>>>(pm, name,
+                                                                     "llvm_ad_mono_polarized");
+    register_variant<Plugin, FloatL, Spectrum<FloatL, 4>>(pm, name, "llvm_ad_spectral");
+    register_variant<Plugin, FloatL, MuellerMatrix<Spectrum<FloatL, 4>>>(pm, name,
+                                                                        "llvm_ad_spectral_polarized");
+    static const char *refused[] = { "cuda_ad_rgb", "cuda_ad_mono", "cuda_ad_mono_polarized",
+                                     "cuda_ad_spectral", "cuda_ad_spectral_polarized" };
+    for (const char *v : refused)
+        register_refusal(pm, name, v);
+}
+
+/// Defined in thinbirefringent.cpp and birefringent.cpp.
+void register_thinbirefringent();
+void register_birefringent();
+
+NAMESPACE_END(shim)
+NAMESPACE_END(mitsuba)

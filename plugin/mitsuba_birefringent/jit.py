@@ -1,0 +1,45 @@
+"""Mitsuba's JIT variants (``llvm_ad_*``) in evaluated mode, which the plugins need.
+
+The plugins compute their lobes in the package's native core, outside Dr.Jit, so they need the
+values of the lanes that hit them: real arrays, not the symbolic variables Dr.Jit records loops
+and virtual calls with by default. Both flags must be off; with either on, the plugins raise an
+error that names them. ``evaluated_mode()`` switches them off around a render::
+
+    import mitsuba as mi
+    import mitsuba_birefringent
+    mi.set_variant("llvm_ad_spectral_polarized")
+    scene = mi.load_dict(...)
+    with mitsuba_birefringent.evaluated_mode():
+        image = mi.render(scene)
+
+Evaluated mode is slower than symbolic mode for every BSDF (each loop iteration and call is a
+kernel of its own) and keeps more memory. While any instance of these plugins exists in the
+process, Dr.Jit's symbolic calls trace it too, so a *symbolic* render of another scene (one
+without the plugins) fails with the same error: render that scene inside ``evaluated_mode()``
+as well, or delete every scene and BSDF of the plugins first (``del scene``, and any exception a
+failed render raised: its traceback holds the scene; then ``gc.collect()``), or use a separate
+process.
+"""
+
+from __future__ import annotations
+
+import contextlib
+from typing import Iterator
+
+import drjit as dr
+
+#: The Dr.Jit flags that must be off.
+FLAGS = (dr.JitFlag.SymbolicLoops, dr.JitFlag.SymbolicCalls)
+
+
+@contextlib.contextmanager
+def evaluated_mode() -> Iterator[None]:
+    """Switches Dr.Jit's symbolic loops and calls off, and restores them on exit."""
+    saved = [dr.flag(f) for f in FLAGS]
+    try:
+        for f in FLAGS:
+            dr.set_flag(f, False)
+        yield
+    finally:
+        for f, value in zip(FLAGS, saved):
+            dr.set_flag(f, value)

@@ -1,0 +1,334 @@
+//! The batch entry points: each lane is the scalar query of the core (a plate's or a crystal's
+//! lobes in their fixed slots, per channel, then the choice of one), written to the outputs.
+//! Nothing is allocated per lane here; panics are caught per lane.
+
+use super::bridge::{
+    Bounds, CrystalLanes, PlateCall, PlateLanes, Samples, Status, Transport as BridgeTransport,
+};
+use super::columns::{Column, Columns3, Wavelengths, MAX_CHANNELS};
+use super::guard::{guarded, status};
+use super::materials::Materials;
+use super::samples::Output;
+use super::spectrum::PlateSpectrum;
+use crate::error::{Error, Result};
+use crate::optics::medium::Uniaxial;
+use crate::optics::surface::Surface;
+use crate::params::{Length, Thickness};
+use crate::render::choice::{choose, Choice};
+use crate::render::crystal::crystal_slots;
+use crate::render::plate::{plate_lobes, PlateQuery, MAX_BANDS};
+use crate::render::slots::{crystal_component, plate_component, Slots, CRYSTAL_SLOTS, PLATE_SLOTS};
+use crate::render::Transport;
+use crate::C64;
+use nalgebra::Vector3;
+
+const _: () = assert!(MAX_CHANNELS == MAX_BANDS);
+const _: () = assert!(Bounds::MaxChannels.repr as usize == MAX_CHANNELS);
+const _: () = assert!(Bounds::PlateComponents.repr as usize == PLATE_SLOTS);
+
+/// One lane's lobes per channel and the slot chosen among them.
+type Sampled<const S: usize> = Option<([Slots<S>; MAX_CHANNELS], Choice)>;
+
+/// Samples a plate lobe in every lane (see `bridge::sample_plate`).
+pub fn sample_plate(
+    materials: &Materials,
+    spectrum: &PlateSpectrum,
+    call: &PlateCall,
+    lanes: &PlateLanes,
+    out: &mut Samples,
+) -> Status {
+    let run = || {
+        let cols = PlateColumns::new(lanes)?;
+        spectrum.check_wavelength_columns(cols.common.wavelengths.count())?;
+        let channels = spectrum.channels(cols.common.wavelengths.count());
+        let mut output = Output::new(out, lanes.count, channels)?;
+        for i in 0..lanes.count {
+            let lane = || plate_lane(materials, spectrum, call, &cols, i);
+            write_lane(
+                &mut output,
+                i,
+                cols.common.active.at(i),
+                lane,
+                plate_component,
+            );
+        }
+        Ok(output.status())
+    };
+    finish(guarded(run), out)
+}
+
+/// Samples a crystal lobe in every lane (see `bridge::sample_crystal`).
+pub fn sample_crystal(
+    materials: &Materials,
+    components: u32,
+    lanes: &CrystalLanes,
+    out: &mut Samples,
+) -> Status {
+    let run = || {
+        let cols = CrystalColumns::new(lanes)?;
+        let channels = cols.common.wavelengths.count();
+        if channels == 0 {
+            return Err(Error::new(
+                "wavelengths_nm",
+                "at least one column is needed",
+            ));
+        }
+        let mut output = Output::new(out, lanes.count, channels)?;
+        for i in 0..lanes.count {
+            let lane = || crystal_lane(materials, components, &cols, i);
+            write_lane(
+                &mut output,
+                i,
+                cols.common.active.at(i),
+                lane,
+                crystal_component,
+            );
+        }
+        Ok(output.status())
+    };
+    finish(guarded(run), out)
+}
+
+/// The call's status; a call that failed as a whole leaves its message.
+fn finish(r: Result<Status>, out: &mut Samples) -> Status {
+    r.unwrap_or_else(|e| {
+        out.message = e.to_string();
+        status(&e)
+    })
+}
+
+/// Computes lane `i` (unless inactive) and writes it.
+fn write_lane<const S: usize>(
+    output: &mut Output,
+    i: usize,
+    active: u8,
+    lane: impl FnOnce() -> Result<Sampled<S>>,
+    component: fn(usize) -> usize,
+) {
+    if active == 0 {
+        return output.nothing(i);
+    }
+    let written = guarded(lane).and_then(|sampled| match sampled {
+        Some((lobes, choice)) => {
+            let channels = &lobes[..output.channels()];
+            output.write(i, channels, choice, component(choice.slot))
+        }
+        None => {
+            output.nothing(i);
+            Ok(())
+        }
+    });
+    if let Err(e) = written {
+        output.fail(i, &e);
+    }
+}
+
+/// The columns both queries share.
+struct CommonColumns<'a> {
+    active: Column<'a, u8>,
+    material: Column<'a, u32>,
+    transport: Column<'a, BridgeTransport>,
+    sample: Column<'a, f64>,
+    wi: Columns3<'a>,
+    wavelengths: Wavelengths<'a>,
+    ext_ior: Column<'a, f64>,
+    optic_axis: Columns3<'a>,
+}
+
+impl<'a> CommonColumns<'a> {
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        n: usize,
+        active: &'a [u8],
+        material: &'a [u32],
+        transport: &'a [BridgeTransport],
+        sample: &'a [f64],
+        wi: &[&'a [f64]; 3],
+        wavelengths: &[&'a [f64]],
+        ext_ior: &'a [f64],
+        optic_axis: &[&'a [f64]; 3],
+    ) -> Result<Self> {
+        Ok(CommonColumns {
+            active: Column::new("active", active, n)?,
+            material: Column::new("material", material, n)?,
+            transport: Column::new("transport", transport, n)?,
+            sample: Column::new("sample", sample, n)?,
+            wi: Columns3::new("wi", wi, n)?,
+            wavelengths: Wavelengths::new(wavelengths, n)?,
+            ext_ior: Column::new("ext_ior", ext_ior, n)?,
+            optic_axis: Columns3::new("optic_axis", optic_axis, n)?,
+        })
+    }
+
+    /// Lane `i`'s transport mode and lobe-choosing number.
+    fn transport_and_sample(&self, i: usize) -> Result<(Transport, f64)> {
+        let transport = match self.transport.at(i) {
+            BridgeTransport::Radiance => Transport::Radiance,
+            BridgeTransport::Importance => Transport::Importance,
+            t => {
+                return Err(Error::new(
+                    "transport",
+                    format!("must be Radiance (0) or Importance (1), got {}", t.repr),
+                ))
+            }
+        };
+        let u = self.sample.at(i);
+        if !(0.0..=1.0).contains(&u) {
+            return Err(Error::new(
+                "sample",
+                format!("must be within [0, 1], got {u}"),
+            ));
+        }
+        Ok((transport, u))
+    }
+}
+
+struct PlateColumns<'a> {
+    common: CommonColumns<'a>,
+    exit_ior: Column<'a, f64>,
+    axis_angle_deg: Column<'a, f64>,
+    thickness_nm: Column<'a, f64>,
+    birefringence: Column<'a, f64>,
+}
+
+impl<'a> PlateColumns<'a> {
+    fn new(l: &PlateLanes<'a>) -> Result<Self> {
+        let n = l.count;
+        Ok(PlateColumns {
+            common: CommonColumns::new(
+                n,
+                l.active,
+                l.material,
+                l.transport,
+                l.sample,
+                &l.wi,
+                l.wavelengths_nm,
+                l.ext_ior,
+                &l.optic_axis,
+            )?,
+            exit_ior: Column::new("exit_ior", l.exit_ior, n)?,
+            axis_angle_deg: Column::new("axis_angle_deg", l.axis_angle_deg, n)?,
+            thickness_nm: Column::new("thickness_nm", l.thickness_nm, n)?,
+            birefringence: Column::new("birefringence", l.birefringence, n)?,
+        })
+    }
+}
+
+struct CrystalColumns<'a> {
+    common: CommonColumns<'a>,
+}
+
+impl<'a> CrystalColumns<'a> {
+    fn new(l: &CrystalLanes<'a>) -> Result<Self> {
+        Ok(CrystalColumns {
+            common: CommonColumns::new(
+                l.count,
+                l.active,
+                l.material,
+                l.transport,
+                l.sample,
+                &l.wi,
+                l.wavelengths_nm,
+                l.ext_ior,
+                &l.optic_axis,
+            )?,
+        })
+    }
+}
+
+/// `axis` rotated about the local normal (z) by `degrees`, counter-clockwise seen from +z (from
+/// the tangent s towards t): the plugin's `axis_angle`, which must be finite.
+fn rotated_about_normal(axis: Vector3<f64>, degrees: f64) -> Result<Vector3<f64>> {
+    if !degrees.is_finite() {
+        return Err(Error::new(
+            "axis_angle",
+            format!("must be a finite number (degrees), got {degrees}"),
+        ));
+    }
+    if degrees == 0.0 {
+        return Ok(axis);
+    }
+    let (s, c) = degrees.to_radians().sin_cos();
+    Ok(Vector3::new(
+        c * axis.x - s * axis.y,
+        s * axis.x + c * axis.y,
+        axis.z,
+    ))
+}
+
+/// True if component `k` is enabled in the bit set `components`.
+fn enabled(components: u32, k: usize) -> bool {
+    k < 32 && components & (1 << k) != 0
+}
+
+/// Lane `i` of a plate batch: the scalar plate query and the choice of its lobe.
+fn plate_lane(
+    materials: &Materials,
+    spectrum: &PlateSpectrum,
+    call: &PlateCall,
+    cols: &PlateColumns,
+    i: usize,
+) -> Result<Sampled<PLATE_SLOTS>> {
+    let c = &cols.common;
+    let (transport, u) = c.transport_and_sample(i)?;
+    let q = PlateQuery::new(
+        *materials.get(c.material.at(i))?,
+        cols.birefringence.at(i),
+        C64::new(c.ext_ior.at(i), 0.0),
+        C64::new(cols.exit_ior.at(i), 0.0),
+        rotated_about_normal(c.optic_axis.at(i), cols.axis_angle_deg.at(i))?,
+        Thickness::new("thickness", cols.thickness_nm.at(i), Length::Micrometres)?,
+        enabled(call.components, 0),
+        enabled(call.components, 1),
+        call.intensity_only,
+    )?
+    .with_absorbing_exit(call.absorbing_exit);
+    let (s, pick) = spectrum.lane(c.wavelengths.at(i), c.wavelengths.count());
+    let per_channel = plate_lobes(&q, &s, c.wi.at(i), transport)?;
+    let mut lobes = [[None; PLATE_SLOTS]; MAX_CHANNELS];
+    match pick {
+        Some(k) => lobes[0] = per_channel[k],
+        None => {
+            for (l, p) in lobes.iter_mut().zip(&per_channel) {
+                *l = *p;
+            }
+        }
+    }
+    let channels = spectrum.channels(c.wavelengths.count());
+    let choice = choose(
+        &lobes[..channels],
+        |slot| enabled(call.components, plate_component(slot)),
+        u,
+    );
+    Ok(choice.map(|choice| (lobes, choice)))
+}
+
+/// Lane `i` of a crystal batch: the crystal's slots at each wavelength and the choice.
+fn crystal_lane(
+    materials: &Materials,
+    components: u32,
+    cols: &CrystalColumns,
+    i: usize,
+) -> Result<Sampled<CRYSTAL_SLOTS>> {
+    let c = &cols.common;
+    let (transport, u) = c.transport_and_sample(i)?;
+    let material = materials.get(c.material.at(i))?;
+    let (ext, axis, wi) = (
+        C64::new(c.ext_ior.at(i), 0.0),
+        c.optic_axis.at(i),
+        c.wi.at(i),
+    );
+    let channels = c.wavelengths.count();
+    let mut lobes = [[None; CRYSTAL_SLOTS]; MAX_CHANNELS];
+    for (slots, &lambda) in lobes.iter_mut().zip(&c.wavelengths.at(i)[..channels]) {
+        let (eo, ee) = material.indices(lambda, 0.0)?;
+        let surface = Surface::new(ext, Uniaxial::new(eo, ee, axis)?)?;
+        *slots = crystal_slots(&surface, wi, transport)?;
+    }
+    let choice = choose(
+        &lobes[..channels],
+        |slot| enabled(components, crystal_component(slot)),
+        u,
+    );
+    Ok(choice.map(|choice| (lobes, choice)))
+}

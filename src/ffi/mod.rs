@@ -1,0 +1,244 @@
+//! The boundary with the C++ shim: a `cxx` bridge, from which `cxx` generates the C++ header
+//! (`birefringent/src/ffi/mod.rs.h`), so that no declaration or constant is written twice.
+//!
+//! The shim asks one question per surface point: which lobe does this path follow, and with
+//! what weight. Queries come in batches of lanes (structure of arrays, doubles; a column holds
+//! one value per lane or one value for all), which is what Mitsuba's JIT variants hand a BSDF
+//! (the lanes that hit one instance); the scalar variants send batches of one lane. Each lane
+//! is computed exactly as the scalar query (`render::plate::plate_lobes` or
+//! `render::crystal::crystal_slots`, then `render::choice::choose`), bit for bit, whatever the
+//! other lanes of the batch hold.
+//!
+//! Rules: every function catches panics (a panic crossing the bridge would abort); invalid
+//! input is reported as [`bridge::Status::Invalid`] with a message naming the parameter, a
+//! defect as [`bridge::Status::Internal`]; no non-finite number is ever written to an output.
+
+mod batch;
+mod columns;
+mod guard;
+mod materials;
+mod samples;
+mod spectrum;
+
+pub use batch::{sample_crystal, sample_plate};
+pub use materials::{new_materials, Materials};
+pub use spectrum::{band_spectrum, channel_spectrum, exact_spectrum, PlateSpectrum};
+
+/// The library's version.
+pub fn version() -> &'static str {
+    env!("CARGO_PKG_VERSION")
+}
+
+#[cxx::bridge(namespace = "bfr")]
+pub mod bridge {
+    /// How a call, or one lane of it, ended.
+    #[repr(u8)]
+    #[derive(Debug)]
+    enum Status {
+        /// Success.
+        Ok = 0,
+        /// Invalid input; the message names the parameter.
+        Invalid = 1,
+        /// A defect of the core (a caught panic or a non-finite result).
+        Internal = 2,
+    }
+
+    /// Mitsuba's `TransportMode`.
+    #[repr(u8)]
+    #[derive(Debug)]
+    enum Transport {
+        /// Paths traced from the camera.
+        Radiance = 0,
+        /// Paths traced from the lights.
+        Importance = 1,
+    }
+
+    /// Colour channels a plate is integrated over in closed form; each channel is normalised
+    /// so that a spectrally flat response of 1 gives 1.
+    #[repr(u8)]
+    #[derive(Debug)]
+    enum ChannelSet {
+        /// Linear sRGB under D65: three channels R, G, B (signed weights).
+        Srgb = 0,
+        /// CIE 1931 Y under D65: one channel (the luminance of the sRGB channels).
+        Luminance = 1,
+    }
+
+    /// Array bounds of the queries.
+    enum Bounds {
+        /// Most channels of one query (the wavelengths Mitsuba's spectral variants trace).
+        MaxChannels = 4,
+        /// Mitsuba components of a plate: 0 reflection, 1 transmission.
+        PlateComponents = 2,
+        /// Mitsuba components of a crystal surface: 0 reflection, 1 ordinary and 2
+        /// extraordinary refraction.
+        CrystalComponents = 3,
+    }
+
+    /// Per-call settings of a plate query.
+    #[derive(Debug)]
+    struct PlateCall {
+        /// The Mitsuba components the context enables: bit k for component k.
+        components: u32,
+        /// Only the unpolarised throughput (`value[0]`) is wanted.
+        intensity_only: bool,
+        /// The exit medium absorbs whatever enters it (a film on a black substrate): no
+        /// transmission and no light from below.
+        absorbing_exit: bool,
+    }
+
+    /// The lanes of a plate query. Every column holds `count` values (one per lane) or one
+    /// (the same for every lane). Local shading frame: z is the normal towards the exterior,
+    /// the exterior medium is above the plate and the exit medium below.
+    #[derive(Debug)]
+    struct PlateLanes<'a> {
+        /// Number of lanes.
+        count: usize,
+        /// 0 for a lane to skip (its outputs are zero), else 1.
+        active: &'a [u8],
+        /// Index of the lane's material in the `Materials` table.
+        material: &'a [u32],
+        /// The lane's transport mode.
+        transport: &'a [Transport],
+        /// A uniform number in [0, 1) that chooses the lobe.
+        sample: &'a [f64],
+        /// Mitsuba's `si.wi` (unit, local).
+        wi: [&'a [f64]; 3],
+        /// Wavelengths (nm), one column per channel, for exact and band spectra; none for a
+        /// channel set.
+        wavelengths_nm: &'a [&'a [f64]],
+        /// Real index of the exterior (z > 0).
+        ext_ior: &'a [f64],
+        /// Real index of the exit medium (below the plate).
+        exit_ior: &'a [f64],
+        /// Optic axis (local, any non-zero length), before `axis_angle_deg`.
+        optic_axis: [&'a [f64]; 3],
+        /// Degrees by which the optic axis is rotated about the normal, counter-clockwise seen
+        /// from the exterior (the plugin's `axis_angle`); 0 for none.
+        axis_angle_deg: &'a [f64],
+        /// Thickness (nm): the plugin's `thickness` (micrometres) times `thickness_scale` (its
+        /// errors speak micrometres), within [0, 1 m].
+        thickness_nm: &'a [f64],
+        /// Added to the extraordinary index (photoelastic stress); 0 for none.
+        birefringence: &'a [f64],
+    }
+
+    /// The lanes of a bulk crystal query (crystal below the surface, z < 0); columns as in
+    /// `PlateLanes`.
+    #[derive(Debug)]
+    struct CrystalLanes<'a> {
+        /// Number of lanes.
+        count: usize,
+        /// 0 for a lane to skip (its outputs are zero), else 1.
+        active: &'a [u8],
+        /// Index of the lane's material in the `Materials` table.
+        material: &'a [u32],
+        /// The lane's transport mode.
+        transport: &'a [Transport],
+        /// A uniform number in [0, 1) that chooses the lobe.
+        sample: &'a [f64],
+        /// Mitsuba's `si.wi` (unit, local; z < 0 inside the crystal).
+        wi: [&'a [f64]; 3],
+        /// Wavelengths (nm), one column per channel (at least one).
+        wavelengths_nm: &'a [&'a [f64]],
+        /// Real index of the exterior (z > 0).
+        ext_ior: &'a [f64],
+        /// Optic axis (local, any non-zero length).
+        optic_axis: [&'a [f64]; 3],
+    }
+
+    /// The lobe each lane samples, as Mitsuba's `BSDFSample3f` and sample weight need it.
+    /// Per-lane columns hold `count` values; per-channel columns `channels * count`, channel
+    /// c of lane i at `c * count + i`. The optional columns (`in_stokes_x`, `out_stokes_x`,
+    /// `value[1..16]`) may be empty, and are then not written. A lane that samples nothing
+    /// (inactive, no lobe enabled, or an error) has `pdf` 0 and zero everywhere else.
+    ///
+    /// Physically the light arrives along `-wo_hat` and leaves along `wi_hat`, where
+    /// `(wo_hat, wi_hat) = (wo, wi)` in Radiance mode and `(wi, wo)` in Importance mode. A
+    /// Stokes frame is given by its x axis; y = (propagation direction) x (x axis).
+    #[derive(Debug)]
+    struct Samples<'a> {
+        /// How each lane ended.
+        status: &'a mut [Status],
+        /// Mitsuba's `sampled_component`.
+        component: &'a mut [u32],
+        /// Probability of choosing this lobe (1 when it is the only candidate).
+        pdf: &'a mut [f64],
+        /// Mitsuba's `bs.eta`: ray index on the `wo` side over the `wi` side.
+        eta: &'a mut [f64],
+        /// Mitsuba's `bs.wo` (unit, local): the direction of the first channel that has the
+        /// lobe (with dispersion the other channels follow it).
+        wo: [&'a mut [f64]; 3],
+        /// Per channel: x axis of the Stokes frame of the light arriving along `-wo_hat`.
+        in_stokes_x: [&'a mut [f64]; 3],
+        /// Per channel: x axis of the Stokes frame of the light leaving along `wi_hat`.
+        out_stokes_x: [&'a mut [f64]; 3],
+        /// Per channel: the sample weight, the lobe's Mueller matrix (row-major, Mitsuba's
+        /// convention, power fractions, in Radiance mode with the radiance factor) divided by
+        /// `pdf`; zero in a channel without the lobe (whose frames are then the first
+        /// channel's).
+        value: [&'a mut [f64]; 16],
+        /// The message of the first lane (or call) that failed.
+        message: String,
+    }
+
+    extern "Rust" {
+        /// A table of materials; lanes refer to them by index.
+        type Materials;
+        /// An empty table.
+        fn new_materials() -> Box<Materials>;
+        /// Appends a named crystal (see the calculator's docs) with extinction added to its
+        /// ordinary and extraordinary indices (>= 0); returns its index.
+        fn add_named(self: &mut Materials, name: &str, kappa_o: f64, kappa_e: f64) -> Result<u32>;
+        /// Appends constant indices `eta_o + i kappa_o`, `eta_e + i kappa_e`; returns its index.
+        fn add_constant(
+            self: &mut Materials,
+            eta_o: f64,
+            eta_e: f64,
+            kappa_o: f64,
+            kappa_e: f64,
+        ) -> Result<u32>;
+        /// True if material `index` is isotropic at every wavelength (equal constant indices).
+        fn is_isotropic(self: &Materials, index: u32) -> bool;
+        /// The warning to show when material `index` is loaded, empty if none: a named crystal
+        /// whose cited data do not cover 360-830 nm (where Mitsuba samples), so that its fit is
+        /// extrapolated there.
+        fn warning(self: &Materials, index: u32) -> String;
+
+        /// What spectrum a plate is evaluated over.
+        type PlateSpectrum;
+        /// Exact at each lane's wavelengths.
+        fn exact_spectrum() -> Box<PlateSpectrum>;
+        /// Closed-form average over a Gaussian band of full width at half maximum `fwhm_nm`
+        /// (the plugin's `filter_bandwidth`; 0 is exact) around each lane's wavelengths,
+        /// checked per lane: within [0, a quarter of the wavelength].
+        fn band_spectrum(fwhm_nm: f64) -> Box<PlateSpectrum>;
+        /// Closed-form integral over a channel set (no wavelengths).
+        fn channel_spectrum(set: ChannelSet) -> Result<Box<PlateSpectrum>>;
+        /// Channels of a query with `wavelengths` wavelength columns.
+        fn channels(self: &PlateSpectrum, wavelengths: usize) -> usize;
+
+        /// Samples a plate lobe (slot 0 reflection, 1 transmission) in every lane. Returns
+        /// `Ok` if every lane succeeded, else the status of the first failure (the call's own,
+        /// e.g. a column of the wrong length, or a lane's) with its message in `out.message`.
+        fn sample_plate(
+            materials: &Materials,
+            spectrum: &PlateSpectrum,
+            call: &PlateCall,
+            lanes: &PlateLanes,
+            out: &mut Samples,
+        ) -> Status;
+
+        /// Samples a crystal lobe in every lane, with the components in the bits of
+        /// `components` enabled; returns as `sample_plate`.
+        fn sample_crystal(
+            materials: &Materials,
+            components: u32,
+            lanes: &CrystalLanes,
+            out: &mut Samples,
+        ) -> Status;
+
+        /// The library's version.
+        fn version() -> &'static str;
+    }
+}
