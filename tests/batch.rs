@@ -358,10 +358,16 @@ fn plate_expected(
     let wi = Vector3::new(at(&l.wi[0]), at(&l.wi[1]), at(&l.wi[2]));
     let mut lobes =
         plate_lobes(&q, &spectrum, wi, transport(l.transport[i])).map_err(|e| e.to_string())?;
+    // A one-channel query (a channel render's pass) chooses over the whole set, so that every
+    // pass of a render chooses alike, and keeps its own channel.
+    let choice = choose(&lobes, |s| enabled(call.components, s), l.sample[i]);
     if let Some(k) = pick {
         lobes = vec![lobes[k]];
     }
-    Ok(choose(&lobes, |s| enabled(call.components, s), l.sample[i]).map(|c| (lobes, c)))
+    Ok(choice.map(|c| {
+        let hero = if pick.is_some() { 0 } else { c.hero };
+        (lobes, Choice { hero, ..c })
+    }))
 }
 
 fn crystal_expected(
