@@ -41,9 +41,6 @@ VARIANT = "llvm_ad_mono_polarized"
 #: The channels of each weight set (the core's names).
 CHANNELS = {"srgb-d65": "RGB", "xyz-d65": "XYZ", "xyz-e": "XYZ"}
 
-#: Mean CIEDE2000 of the two-plate scene of docs/physics.md, section 7 (the warning quotes it).
-TWO_PLATE_ERROR = "mean CIEDE2000 {two_plates}"
-
 
 def render_analytic(scene: dict, spp: int = 16, weights: str = "srgb-d65",
                     seed: int = 0) -> dict[str, Any]:
@@ -123,8 +120,9 @@ def warn_where_inexact(scene: dict) -> None:
         warnings.warn(
             f"the scene has {plates} thinbirefringent plates: where a path passes through two of "
             "them, the channel render multiplies their channel integrals, which is not the "
-            "integral of their product (two stacked quartz plates: "
-            f"{TWO_PLATE_ERROR}; docs/physics.md, section 7). Plates side by side are exact.",
+            "integral of their product (two quartz plates stacked between crossed polarisers: "
+            "CIEDE2000 0.16 for 5 + 60 um, 2-3 for 20 + 35 um, 8.3 for 50 + 50 um with parallel "
+            "axes; docs/physics.md, section 7). Plates side by side are exact.",
             stacklevel=3)
     if any(n["type"] == "birefringent" for n in nodes):
         warnings.warn(
