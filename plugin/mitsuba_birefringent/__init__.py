@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import importlib.metadata
 
-from .analytic import render_analytic
 from .jit import evaluated_mode
 from .library import core_version, library_path, register, supported_variants
 
@@ -45,3 +44,12 @@ register()
 
 #: The Mitsuba variants the plugins work in (as the plugin library registers them).
 VARIANTS = supported_variants()
+
+
+def __getattr__(name: str):
+    # render_analytic needs numpy, which the plugins alone do not: imported on first use.
+    if name == "render_analytic":
+        from .analytic import render_analytic
+
+        return render_analytic
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

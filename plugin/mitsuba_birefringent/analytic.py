@@ -29,7 +29,11 @@ import warnings
 from typing import Any, Iterator
 
 import mitsuba as mi
-import numpy as np
+
+try:
+    import numpy as np
+except ImportError:  # the plugins need no numpy; channel renders do
+    raise ImportError("mitsuba_birefringent.render_analytic needs numpy: pip install numpy") from None
 
 from .channel_scene import PLUGIN_TYPES, ChannelScene
 from .jit import evaluated_mode
