@@ -138,15 +138,19 @@ plugin-lib:
 
 ## ---- main job ---------------------------------------------------------------------------
 
-# The default scene (scenes/photoelastic_disk.py, scalar_spectral_polarized) and Figure 1 of the
-# supplemental (Fresnel power ratios of an isotropic/uniaxial interface, computed by the
-# calculator binary, a few seconds). Always regenerated.
+# The default scene (scenes/photoelastic_disk.py) rendered by colour channels
+# (mitsuba_birefringent.render_analytic: one llvm_ad_mono_polarized pass per sRGB channel, the
+# plate integrated over each in closed form, no colour noise), and Figure 1 of the supplemental
+# (Fresnel power ratios of an isotropic/uniaxial interface, computed by the calculator binary, a
+# few seconds). Always regenerated. RENDER_MODE=spectral renders the scene by spectral sampling
+# in scalar_spectral_polarized instead.
 RENDER_SCENE ?= photoelastic_disk
 RENDER_SPP ?= 16
 RENDER_SIZE ?= 320
+RENDER_MODE ?= analytic
 render: setup
 	@mkdir -p $(OUT)
-	$(VPY) scenes/render.py $(RENDER_SCENE) --out $(OUT) --spp $(RENDER_SPP) --width $(RENDER_SIZE) --height $(RENDER_SIZE)
+	$(VPY) scenes/render.py $(RENDER_SCENE) --out $(OUT) --spp $(RENDER_SPP) --width $(RENDER_SIZE) --height $(RENDER_SIZE) $(if $(filter spectral,$(RENDER_MODE)),,--analytic)
 	$(VPY) tools/plot_fig1.py $(BIN) $(OUT)
 
 # Every scene module of scenes/ (a `scene` function and `VARIANTS`) at gallery size, then the

@@ -2,6 +2,7 @@
 
     .venv/bin/python scenes/render.py photoelastic_disk --out out [--spp 16] [--width 512]
         [--height 512] [--variant scalar_spectral_polarized] [--set load_n=800 --set ...]
+        [--analytic [--weights srgb-d65]]
 
 A scene module (`scenes/<name>.py`) has a docstring (what it shows, the physics, the check), a
 constant `VARIANTS` (the Mitsuba variants it renders in, the first is the default) and
@@ -12,6 +13,12 @@ option (the value is read as a Python literal when it is one, else as a string).
 Outputs: `<out>/<name>.exr` (every channel of the film, named as Mitsuba names them) and
 `<out>/<name>.png` (`preview`: sRGB of the RGB channels; for a `stokes` render, the Stokes
 vector as colours; for a one-channel monochromatic film, grey).
+
+`--analytic` renders with `mitsuba_birefringent.render_analytic` instead (one
+llvm_ad_mono_polarized pass per channel of `--weights`, every plate integrated over the channel in
+closed form: no colour noise; the scene dict is built in the scene's first variant). Its EXR has
+the channels R, G, B (linear sRGB) and, for a `stokes` integrator, S0..S3 of each; `--spp`
+defaults to the scene's own sample count.
 """
 
 from __future__ import annotations
@@ -87,6 +94,32 @@ def render(name: str, out: pathlib.Path, variant: str | None = None, seed: int =
     return png
 
 
+def render_analytic(name: str, out: pathlib.Path, weights: str = "srgb-d65", seed: int = 0,
+                    **options) -> pathlib.Path:
+    """Renders scene `name` by channels (module docstring) to `<out>/<name>.exr` and `.png`."""
+    module = importlib.import_module(name)
+    mi.set_variant(module.VARIANTS[0])
+    import mitsuba_birefringent
+
+    scene = module.scene(**options)
+    spp = options.get("spp") or scene["sensor"].get("sampler", {}).get("sample_count", 16)
+    start = time.perf_counter()
+    result = mitsuba_birefringent.render_analytic(scene, spp=spp, weights=weights, seed=seed)
+    seconds = time.perf_counter() - start
+    names, planes = ["R", "G", "B"], [result["rgb"]]
+    if "stokes" in result:
+        names += [f"S{i}.{c}" for i in range(4) for c in "RGB"]
+        planes.append(result["stokes"].reshape(*result["rgb"].shape[:2], 12))
+    image = np.concatenate(planes, axis=-1).astype(np.float32)
+    out.mkdir(parents=True, exist_ok=True)
+    exr = out / f"{name}.exr"
+    mi.Bitmap(image, mi.Bitmap.PixelFormat.MultiChannel, names).write(str(exr))
+    png = out / f"{name}.png"
+    mi.util.convert_to_bitmap(mi.Bitmap(preview(image).astype(np.float32))).write(str(png))
+    print(f"{name} (by channels, {weights}, {spp} spp per pass): {exr} and {png} in {seconds:.1f} s")
+    return png
+
+
 def parse_value(text: str):
     try:
         return ast.literal_eval(text)
@@ -104,6 +137,10 @@ def main() -> None:
     p.add_argument("--variant", default=None, help="default: the scene's VARIANTS[0]")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="a physics option of the scene (repeatable)")
+    p.add_argument("--analytic", action="store_true",
+                   help="render by colour channels (mitsuba_birefringent.render_analytic)")
+    p.add_argument("--weights", default="srgb-d65", help="channels of --analytic: srgb-d65, "
+                   "xyz-d65 or xyz-e (default srgb-d65)")
     a = p.parse_args()
     options = {k: v for k, v in (("spp", a.spp), ("width", a.width), ("height", a.height)) if v is not None}
     for item in a.set:
@@ -111,7 +148,12 @@ def main() -> None:
         if not sep:
             p.error(f"--set {item!r}: expected KEY=VALUE")
         options[key] = parse_value(value)
-    render(a.scene, a.out, variant=a.variant, **options)
+    if a.analytic:
+        if a.variant:
+            p.error("--analytic renders in llvm_ad_mono_polarized; --variant does not apply")
+        render_analytic(a.scene, a.out, weights=a.weights, **options)
+    else:
+        render(a.scene, a.out, variant=a.variant, **options)
 
 
 if __name__ == "__main__":

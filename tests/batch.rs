@@ -7,11 +7,11 @@
 //! wrong length are refused with a message naming them.
 
 use birefringent::ffi::bridge::{
-    ChannelSet, CrystalLanes, PlateCall, PlateLanes, Samples, Status, Transport as T,
+    CrystalLanes, PlateCall, PlateLanes, Samples, Status, Transport as T,
 };
 use birefringent::ffi::{
-    band_spectrum, channel_spectrum, exact_spectrum, new_materials, sample_crystal, sample_plate,
-    Materials, PlateSpectrum,
+    band_spectrum, colour_channel_spectrum, exact_spectrum, new_materials, sample_crystal,
+    sample_plate, srgb_spectrum, Materials, PlateSpectrum,
 };
 use birefringent::material::Material;
 use birefringent::optics::medium::Uniaxial;
@@ -358,10 +358,16 @@ fn plate_expected(
     let wi = Vector3::new(at(&l.wi[0]), at(&l.wi[1]), at(&l.wi[2]));
     let mut lobes =
         plate_lobes(&q, &spectrum, wi, transport(l.transport[i])).map_err(|e| e.to_string())?;
+    // A one-channel query (a channel render's pass) chooses over the whole set, so that every
+    // pass of a render chooses alike, and keeps its own channel.
+    let choice = choose(&lobes, |s| enabled(call.components, s), l.sample[i]);
     if let Some(k) = pick {
         lobes = vec![lobes[k]];
     }
-    Ok(choose(&lobes, |s| enabled(call.components, s), l.sample[i]).map(|c| (lobes, c)))
+    Ok(choice.map(|c| {
+        let hero = if pick.is_some() { 0 } else { c.hero };
+        (lobes, Choice { hero, ..c })
+    }))
 }
 
 fn crystal_expected(
@@ -448,15 +454,21 @@ fn plate_spectra() -> Vec<(Box<PlateSpectrum>, Spectrum, Option<usize>, usize)> 
         (exact_spectrum(), bands(0.0), None, 4),
         (band_spectrum(4.0), bands(4.0), None, 3),
         (
-            channel_spectrum(ChannelSet::Srgb).unwrap(),
+            srgb_spectrum(),
             Spectrum::Weights(WeightSet::SrgbD65),
             None,
             0,
         ),
         (
-            channel_spectrum(ChannelSet::Luminance).unwrap(),
+            colour_channel_spectrum("xyz-d65:Y").unwrap(),
             Spectrum::Weights(WeightSet::XyzD65),
             Some(1),
+            0,
+        ),
+        (
+            colour_channel_spectrum("srgb-d65:B").unwrap(),
+            Spectrum::Weights(WeightSet::SrgbD65),
+            Some(2),
             0,
         ),
     ]
@@ -647,7 +659,7 @@ fn broadcast_columns_and_refusals() {
         Status::Invalid
     );
     // A channel set takes no wavelength columns.
-    let srgb = channel_spectrum(ChannelSet::Srgb).unwrap();
+    let srgb = srgb_spectrum();
     let mut rgb = Out::new(n, 3, true);
     assert_eq!(rgb.run_plate(&m, &srgb, &call, &l), Status::Invalid);
     assert!(
@@ -655,7 +667,11 @@ fn broadcast_columns_and_refusals() {
         "{}",
         rgb.message
     );
-    assert!(channel_spectrum(ChannelSet { repr: 9 }).is_err());
+    for bad in ["xyz-d65", "srgb-d65:Y", "XYZ-D65:Y", "luminance"] {
+        let e = colour_channel_spectrum(bad).expect_err(bad).to_string();
+        assert!(e.starts_with("channel: must be one of xyz-e:X"), "{e}");
+        assert!(e.contains(&format!("got \"{bad}\"")), "{e}");
+    }
     // A band is checked per lane, against its wavelength (a quarter of it at most).
     for fwhm in [-1.0, f64::NAN, 200.0] {
         let mut out = Out::new(n, 4, true);

@@ -6,10 +6,10 @@
 //! crystal; failing lanes and a refused call).
 
 use birefringent::ffi::bridge::{
-    ChannelSet, CrystalLanes, PlateCall, PlateLanes, Samples, Status, Transport as T,
+    CrystalLanes, PlateCall, PlateLanes, Samples, Status, Transport as T,
 };
 use birefringent::ffi::{
-    band_spectrum, channel_spectrum, new_materials, sample_crystal, sample_plate,
+    band_spectrum, new_materials, sample_crystal, sample_plate, srgb_spectrum,
 };
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -209,7 +209,7 @@ fn cxx_program_agrees_with_the_rust_side() {
         "{}",
         lines[at]
     );
-    let srgb = channel_spectrum(ChannelSet::Srgb).unwrap();
+    let srgb = srgb_spectrum();
     let rgb = PlateLanes {
         wavelengths_nm: &[],
         ..p

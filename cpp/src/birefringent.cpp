@@ -55,6 +55,14 @@ Bulk birefringent crystal (:monosp:`birefringent`)
      (Default: ``"air"``, 1.000277)
    - |exposed|
 
+ * - channel
+   - |string|
+   - Mono variants only: the colour channel of the render (as :monosp:`thinbirefringent`'s
+     ``channel``). A crystal's refraction directions depend on the wavelength, so it cannot be
+     integrated over a channel: it is evaluated at the channel's mean wavelength (where the
+     channel's weight is positive; ``xyz-d65:Y`` 557 nm). Refused in the other variants.
+     (Default: ``"xyz-d65:Y"``)
+
 The surface of a bulk uniaxial crystal, like :monosp:`dielectric`: the crystal is on the side
 opposite to the normal. Components: 0 the specular reflection (``DeltaReflection``), 1 the
 ordinary and 2 the extraordinary refraction (``DeltaTransmission``), each ray in its own
@@ -97,10 +105,10 @@ public:
     using Answers = shim::Answers<Float, Spectrum>;
     using Vec3d = typename Answers::Vec3d;
 
-    /// Wavelength (nm) of the RGB and mono variants, which have none: there the crystal is
-    /// evaluated at this wavelength (only isotropic constant indices are allowed in the
-    /// unpolarised ones, where it does not matter).
-    static constexpr double FixedWavelength = 550.0;
+    /// Wavelength (nm) of the RGB variants, which have none (only isotropic constant indices
+    /// are allowed there, so it does not matter). The mono variants evaluate the crystal at
+    /// their `channel`'s mean wavelength.
+    static constexpr double RgbWavelength = 550.0;
 
     Birefringent(const Properties &props) : Base(props) {
         m_params = shim::parse_material(props, ClassName);
@@ -110,6 +118,9 @@ public:
         if (space != "local" && space != "world")
             Throw("\"optic_axis_space\" must be \"local\" (the shading frame) or \"world\", got \"%s\"", space);
         m_axis_in_world = space == "world";
+        m_channel = shim::parse_channel<Spectrum>(props, ClassName);
+        if constexpr (is_monochromatic_v<Spectrum>)
+            m_wavelength = shim::core_call(ClassName, [&] { return bfr::colour_channel_wavelength(m_channel); });
         parameters_changed();
     }
 
@@ -190,8 +201,10 @@ public:
             << "  " << m_params.to_string() << "," << std::endl
             << "  ext_ior = " << m_ext_ior << "," << std::endl
             << "  optic_axis = " << m_optic_axis << " (" << (m_axis_in_world ? "world" : "local")
-            << " frame)" << std::endl
-            << "]";
+            << " frame)";
+        if constexpr (is_monochromatic_v<Spectrum>)
+            oss << "," << std::endl << "  channel = \"" << m_channel << "\" (at " << m_wavelength << " nm)";
+        oss << std::endl << "]";
         return oss.str();
     }
 
@@ -201,7 +214,8 @@ private:
     /// Input columns of a core query (indices into shim::ChunkBuffers::in).
     enum Column : size_t { AxisX, AxisY, AxisZ, WiX, WiY, WiZ, Sample, ExtIor, Wavelength0 };
 
-    /// One core query at normal incidence, 550 nm, with the axis as given; throws its message.
+    /// One core query at normal incidence, at the variant's wavelength (550 nm in the spectral
+    /// ones), with the axis as given; throws its message.
     void check_at_load() const {
         shim::ChunkBuffers<1> b;
         const uint8_t one = 1;
@@ -216,7 +230,7 @@ private:
         lanes.sample = { &u, 1 };
         lanes.wi = { b.constant(WiX, 0.0).slice(), b.constant(WiY, 0.0).slice(),
                      b.constant(WiZ, 1.0).slice() };
-        b.constant(Wavelength0, FixedWavelength);
+        b.constant(Wavelength0, m_wavelength);
         lanes.wavelengths_nm = b.wavelength_columns(Wavelength0, 1);
         lanes.ext_ior = b.constant(ExtIor, m_ext_ior).slice();
         lanes.optic_axis = { b.constant(AxisX, m_optic_axis.x()).slice(),
@@ -276,7 +290,7 @@ private:
                 for (size_t c = 0; c < waves; ++c)
                     b.convert(Wavelength0 + c, in.floats(k_waves + c), begin, end);
             } else {
-                b.constant(Wavelength0, FixedWavelength);
+                b.constant(Wavelength0, m_wavelength);
             }
             lanes.wavelengths_nm = b.wavelength_columns(Wavelength0, waves);
             lanes.ext_ior = b.constant(ExtIor, m_ext_ior).slice();
@@ -307,6 +321,8 @@ private:
     double m_ext_ior;
     ScalarVector3f m_optic_axis;
     bool m_axis_in_world = false;
+    std::string m_channel;                ///< the colour channel of a mono variant's render
+    double m_wavelength = RgbWavelength;  ///< where the RGB and mono variants evaluate it
     BSDFFlags m_types[(size_t) bfr::Bounds::CrystalComponents];
     mutable std::atomic<bool> m_warned { false };
     std::unique_ptr<shim::Snapshot<Float, Spectrum>> m_valid;  ///< last valid state

@@ -1,5 +1,6 @@
 //! The plugin library's C entry points, called by the Python package (`ctypes`): registration
-//! of the Mitsuba plugins (the C++ shim of this crate), the version and the supported variants.
+//! of the Mitsuba plugins (the C++ shim of this crate), the version, the supported variants and
+//! the colour matrix of a channel render.
 //! Everything else the shim needs from the core goes through the core's bridge.
 
 use std::ffi::{c_char, CStr};
@@ -78,4 +79,39 @@ pub extern "C" fn bfr_mitsuba_version() -> *const c_char {
 pub extern "C" fn bfr_mitsuba_variants() -> *const c_char {
     static CELL: OnceLock<Vec<u8>> = OnceLock::new();
     c_string(&CELL, || shim::supported_variants().to_string())
+}
+
+/// Writes into `out` (9 doubles, row-major) the matrix from the normalised channel values of
+/// the weight set named `weights` (NUL-terminated: `srgb-d65`, `xyz-d65`, `xyz-e`) to linear
+/// sRGB (the core's `channels_to_linear_srgb`). Returns 0, or 1 with a message in `message`.
+///
+/// # Safety
+/// `weights` is a NUL-terminated string, `out` points to 9 writable doubles, `message` is null
+/// or points to `message_len` writable bytes.
+#[no_mangle]
+pub unsafe extern "C" fn bfr_mitsuba_channel_matrix(
+    weights: *const c_char,
+    out: *mut f64,
+    message: *mut c_char,
+    message_len: usize,
+) -> i32 {
+    let outcome = std::panic::catch_unwind(|| {
+        // SAFETY: the caller's contract.
+        let name = unsafe { CStr::from_ptr(weights) }
+            .to_str()
+            .map_err(|_| "weights: not UTF-8".to_string())?;
+        birefringent::ffi::channels_to_linear_srgb(name).map_err(|e| e.to_string())
+    });
+    let text = match outcome {
+        Ok(Ok(m)) => {
+            // SAFETY: the caller's contract.
+            unsafe { std::ptr::copy_nonoverlapping(m.as_ptr(), out, 9) };
+            return 0;
+        }
+        Ok(Err(e)) => e,
+        Err(_) => "internal error (panic caught) in the colour matrix".to_string(),
+    };
+    // SAFETY: the caller's contract.
+    unsafe { write_message(&text, message, message_len) };
+    1
 }

@@ -85,6 +85,16 @@ Birefringent plate (:monosp:`thinbirefringent`)
      error in the scene benchmark); at most a quarter of the wavelength. (Default: 0)
    - |exposed|
 
+ * - channel
+   - |string|
+   - Mono variants only: the colour channel the plate is integrated over in closed form,
+     ``"<weights>:<channel>"`` with weights ``srgb-d65`` (channels ``R``, ``G``, ``B``: linear
+     sRGB under D65, signed), ``xyz-d65`` or ``xyz-e`` (``X``, ``Y``, ``Z``: CIE 1931 under D65
+     or the equal-energy illuminant), each normalised so that a spectrally flat plate gives 1.
+     A render per channel (``mitsuba_birefringent.render_analytic`` does this) gives the
+     plate's colours without colour noise. Refused in the other variants. (Default:
+     ``"xyz-d65:Y"``, the luminance)
+
  * - absorbing_exit
    - |bool|
    - The medium below the plate absorbs all light that enters it (a film on a black substrate;
@@ -164,6 +174,7 @@ public:
                                                                  "degrees", ClassName);
         m_filter_bandwidth = props.get<double>("filter_bandwidth", DefaultFilterBandwidth);
         m_absorbing_exit = props.get<bool>("absorbing_exit", false);
+        m_channel = shim::parse_channel<Spectrum>(props, ClassName);
         parameters_changed();
     }
 
@@ -202,9 +213,10 @@ private:
         m_band = bfr::band_spectrum(m_filter_bandwidth);
         if constexpr (is_spectral_v<Spectrum>)
             m_spectrum = bfr::band_spectrum(m_filter_bandwidth);
+        else if constexpr (is_rgb_v<Spectrum>)
+            m_spectrum = bfr::srgb_spectrum();
         else
-            m_spectrum = bfr::channel_spectrum(is_rgb_v<Spectrum> ? bfr::ChannelSet::Srgb
-                                                                 : bfr::ChannelSet::Luminance);
+            m_spectrum = shim::core_call(ClassName, [&] { return bfr::colour_channel_spectrum(m_channel); });
         m_null = m_exit_ior == m_ext_ior && !m_absorbing_exit;
         bool isotropic = m_material->is_isotropic(0) && !m_birefringence;
         uint32_t aniso = isotropic ? 0u : (uint32_t) BSDFFlags::Anisotropic;
@@ -271,8 +283,10 @@ public:
         if (m_axis_angle)
             oss << "  axis_angle = " << string::indent(m_axis_angle) << " (degrees)," << std::endl;
         oss << "  filter_bandwidth = " << m_filter_bandwidth << " (nm FWHM, spectral variants)," << std::endl
-            << "  absorbing_exit = " << (m_absorbing_exit ? "true" : "false") << std::endl
-            << "]";
+            << "  absorbing_exit = " << (m_absorbing_exit ? "true" : "false");
+        if constexpr (is_monochromatic_v<Spectrum>)
+            oss << "," << std::endl << "  channel = \"" << m_channel << "\"";
+        oss << std::endl << "]";
         return oss.str();
     }
 
@@ -418,6 +432,7 @@ private:
     ScalarVector3f m_optic_axis;
     ref<Texture> m_thickness, m_birefringence, m_axis_angle;
     double m_thickness_scale, m_birefringence_scale, m_filter_bandwidth;
+    std::string m_channel;  ///< the colour channel of a mono variant's render
     bool m_null = true, m_absorbing_exit = false;
     BSDFFlags m_types[(size_t) bfr::Bounds::PlateComponents];
     mutable std::atomic<bool> m_warned { false };

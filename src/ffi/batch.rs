@@ -285,6 +285,14 @@ fn plate_lane(
     .with_absorbing_exit(call.absorbing_exit);
     let (s, pick) = spectrum.lane(c.wavelengths.at(i), c.wavelengths.count());
     let per_channel = plate_lobes(&q, &s, c.wi.at(i), transport)?;
+    // The lobe is chosen over every channel of the set, also when the query keeps one: the
+    // passes of a channel render then choose alike, and their remaining noise (which lobe a
+    // path follows) scales the channels together (no colour noise).
+    let choice = choose(
+        &per_channel,
+        |slot| enabled(call.components, plate_component(slot)),
+        u,
+    );
     let mut lobes = [[None; PLATE_SLOTS]; MAX_CHANNELS];
     match pick {
         Some(k) => lobes[0] = per_channel[k],
@@ -294,13 +302,11 @@ fn plate_lane(
             }
         }
     }
-    let channels = spectrum.channels(c.wavelengths.count());
-    let choice = choose(
-        &lobes[..channels],
-        |slot| enabled(call.components, plate_component(slot)),
-        u,
-    );
-    Ok(choice.map(|choice| (lobes, choice)))
+    let kept = |choice: Choice| Choice {
+        hero: if pick.is_some() { 0 } else { choice.hero },
+        ..choice
+    };
+    Ok(choice.map(|choice| (lobes, kept(choice))))
 }
 
 /// Lane `i` of a crystal batch: the crystal's slots at each wavelength and the choice.

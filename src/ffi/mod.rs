@@ -22,7 +22,10 @@ mod spectrum;
 
 pub use batch::{sample_crystal, sample_plate};
 pub use materials::{new_materials, Materials};
-pub use spectrum::{band_spectrum, channel_spectrum, exact_spectrum, PlateSpectrum};
+pub use spectrum::{
+    band_spectrum, channels_to_linear_srgb, colour_channel_spectrum, colour_channel_wavelength,
+    exact_spectrum, srgb_spectrum, PlateSpectrum,
+};
 
 /// The library's version.
 pub fn version() -> &'static str {
@@ -51,17 +54,6 @@ pub mod bridge {
         Radiance = 0,
         /// Paths traced from the lights.
         Importance = 1,
-    }
-
-    /// Colour channels a plate is integrated over in closed form; each channel is normalised
-    /// so that a spectrally flat response of 1 gives 1.
-    #[repr(u8)]
-    #[derive(Debug)]
-    enum ChannelSet {
-        /// Linear sRGB under D65: three channels R, G, B (signed weights).
-        Srgb = 0,
-        /// CIE 1931 Y under D65: one channel (the luminance of the sRGB channels).
-        Luminance = 1,
     }
 
     /// Array bounds of the queries.
@@ -213,8 +205,17 @@ pub mod bridge {
         /// (the plugin's `filter_bandwidth`; 0 is exact) around each lane's wavelengths,
         /// checked per lane: within [0, a quarter of the wavelength].
         fn band_spectrum(fwhm_nm: f64) -> Box<PlateSpectrum>;
-        /// Closed-form integral over a channel set (no wavelengths).
-        fn channel_spectrum(set: ChannelSet) -> Result<Box<PlateSpectrum>>;
+        /// Closed-form integral over the three linear sRGB channels under D65 (signed weights;
+        /// no wavelengths): the RGB variants. Each channel is normalised so that a spectrally
+        /// flat response of 1 gives 1.
+        fn srgb_spectrum() -> Box<PlateSpectrum>;
+        /// Closed-form integral over one colour channel named `"<weights>:<channel>"` (the
+        /// plugins' `channel` parameter: `srgb-d65` R, G, B; `xyz-d65` or `xyz-e` X, Y, Z; no
+        /// wavelengths): the mono variants, one channel per render.
+        fn colour_channel_spectrum(name: &str) -> Result<Box<PlateSpectrum>>;
+        /// The wavelength (nm) at which a render of channel `name` evaluates a bulk crystal
+        /// (its refraction's directions depend on the wavelength): the channel's mean.
+        fn colour_channel_wavelength(name: &str) -> Result<f64>;
         /// Channels of a query with `wavelengths` wavelength columns.
         fn channels(self: &PlateSpectrum, wavelengths: usize) -> usize;
 

@@ -1,8 +1,8 @@
 //! The tagged spectrum of a plate query.
 
-use super::bridge::ChannelSet;
 use crate::error::{Error, Result};
 use crate::render::plate::{Spectrum, MAX_BANDS};
+use crate::spectral::channel::{self, Channel};
 use crate::spectral::weights::WeightSet;
 
 /// What a plate query integrates over (see `bridge::PlateSpectrum`).
@@ -15,8 +15,8 @@ pub enum PlateSpectrum {
     },
     /// The sRGB channels.
     Srgb,
-    /// The luminance: the Y channel of CIE XYZ under D65.
-    Luminance,
+    /// One colour channel (a mono variant's render).
+    Channel(Channel),
 }
 
 /// Exact at each lane's wavelengths.
@@ -30,20 +30,48 @@ pub fn band_spectrum(fwhm_nm: f64) -> Box<PlateSpectrum> {
     Box::new(PlateSpectrum::Bands { fwhm_nm })
 }
 
-/// A channel set.
-pub fn channel_spectrum(set: ChannelSet) -> Result<Box<PlateSpectrum>> {
-    match set {
-        ChannelSet::Srgb => Ok(Box::new(PlateSpectrum::Srgb)),
-        ChannelSet::Luminance => Ok(Box::new(PlateSpectrum::Luminance)),
-        _ => Err(Error::new(
-            "set",
-            format!("unknown channel set {}", set.repr),
-        )),
-    }
+/// The three linear sRGB channels (the RGB variants).
+pub fn srgb_spectrum() -> Box<PlateSpectrum> {
+    Box::new(PlateSpectrum::Srgb)
 }
 
-/// Index of the Y channel in the XYZ weight sets.
-const Y: usize = 1;
+/// The colour channel named `name` (the plugins' `channel` parameter, e.g. `"srgb-d65:R"`).
+pub fn colour_channel_spectrum(name: &str) -> Result<Box<PlateSpectrum>> {
+    Ok(Box::new(PlateSpectrum::Channel(parse_channel(name)?)))
+}
+
+/// The wavelength (nm) at which a channel render evaluates a bulk crystal, whose refraction
+/// cannot be integrated over the channel: the channel's mean wavelength
+/// ([`Channel::mean_wavelength_nm`]).
+pub fn colour_channel_wavelength(name: &str) -> Result<f64> {
+    Ok(parse_channel(name)?.mean_wavelength_nm())
+}
+
+/// The matrix (row-major) from the normalised channel values of the weight set `weights`
+/// (`"srgb-d65"`, `"xyz-d65"`, `"xyz-e"`) to linear sRGB ([`channel::to_linear_srgb`]).
+pub fn channels_to_linear_srgb(weights: &str) -> Result<[f64; 9]> {
+    let set = WeightSet::parse(weights).ok_or_else(|| {
+        Error::new(
+            "weights",
+            format!("must be \"srgb-d65\", \"xyz-d65\" or \"xyz-e\", got \"{weights}\""),
+        )
+    })?;
+    let m = channel::to_linear_srgb(set);
+    Ok(std::array::from_fn(|i| m[i / 3][i % 3]))
+}
+
+/// The plugins' `channel` parameter, validated.
+fn parse_channel(name: &str) -> Result<Channel> {
+    Channel::parse(name).ok_or_else(|| {
+        Error::new(
+            "channel",
+            format!(
+                "must be one of {}, got \"{name}\"",
+                Channel::all_names().join(", ")
+            ),
+        )
+    })
+}
 
 impl PlateSpectrum {
     /// Channels of a query with `wavelengths` wavelength columns.
@@ -51,7 +79,7 @@ impl PlateSpectrum {
         match self {
             PlateSpectrum::Bands { .. } => wavelengths,
             PlateSpectrum::Srgb => 3,
-            PlateSpectrum::Luminance => 1,
+            PlateSpectrum::Channel(_) => 1,
         }
     }
 
@@ -88,7 +116,7 @@ impl PlateSpectrum {
                 None,
             ),
             PlateSpectrum::Srgb => (Spectrum::Weights(WeightSet::SrgbD65), None),
-            PlateSpectrum::Luminance => (Spectrum::Weights(WeightSet::XyzD65), Some(Y)),
+            PlateSpectrum::Channel(c) => (Spectrum::Weights(c.set), Some(c.index)),
         }
     }
 }

@@ -3,8 +3,10 @@
 //! traces along one path, or colour channels), so that every channel's expectation is the sum
 //! of its lobes.
 //!
-//! A slot is chosen with probability proportional to its unpolarised throughput (`M00`,
-//! negative values counted as 0) summed over the channels; the ray follows the slot's
+//! A slot is chosen with probability proportional to the magnitude of its unpolarised
+//! throughput (`|M00|`) summed over the channels (a signed sRGB channel is negative where the
+//! plate's colour lies outside the gamut: a lobe negative in every channel of the query, as in
+//! a one-channel render, must still be chosen for the expectation to hold); the ray follows the slot's
 //! direction in the first channel that has it (the hero wavelength), and every channel carries
 //! its own lobe of that slot divided by the probability. With dispersion the other wavelengths
 //! are thus propagated along the hero's direction: their Fresnel, polarisation, o/e split and
@@ -38,7 +40,7 @@ pub fn choose<const S: usize>(
     let weight: [Option<f64>; S] = std::array::from_fn(|slot| {
         let lobes = channels.iter().filter_map(|c| c[slot].as_ref());
         (enabled(slot) && lobes.clone().next().is_some())
-            .then(|| lobes.map(|l| l.weight.max(0.0)).sum())
+            .then(|| lobes.map(|l| l.weight.abs()).sum())
     });
     let chosen = |slot: usize, pdf: f64| Choice {
         slot,
@@ -108,14 +110,29 @@ mod tests {
         assert_eq!(choose(&channels, |_| true, 1.0).unwrap().slot, 2);
     }
 
-    /// A single candidate has probability 1 even at zero or negative weight; several
-    /// candidates without weight give nothing; disabled slots never appear.
+    /// A negative lobe (a signed channel) is chosen by its magnitude: one channel with lobes
+    /// -0.2 and 0.6 picks them with probabilities 0.25 and 0.75, so that the expectation
+    /// -0.2 + 0.6 holds (with negatives counted as 0 it came out 0.6).
+    #[test]
+    fn negative_lobes_are_chosen_by_magnitude() {
+        let channels = [[lobe(-0.2), lobe(0.6)]];
+        let c = choose(&channels, |_| true, 0.1).unwrap();
+        assert_eq!(c.slot, 0);
+        assert!((c.pdf - 0.25).abs() < 1e-15);
+        let c = choose(&channels, |_| true, 0.5).unwrap();
+        assert_eq!(c.slot, 1);
+        assert!((c.pdf - 0.75).abs() < 1e-15);
+    }
+
+    /// A single candidate has probability 1 even at zero weight; several candidates without
+    /// weight give nothing; disabled slots never appear.
     #[test]
     fn single_candidates_and_empty_choices() {
         let channels = [[lobe(-0.2), lobe(0.0), None]];
         let c = choose(&channels, |s| s == 0, 0.7).unwrap();
         assert_eq!((c.slot, c.pdf), (0, 1.0));
-        assert_eq!(choose(&channels, |_| true, 0.5), None);
+        let zero = [[lobe(0.0), lobe(0.0), None]];
+        assert_eq!(choose(&zero, |_| true, 0.5), None);
         assert_eq!(choose(&channels, |s| s == 2, 0.5), None);
         let none: [Slots<3>; 1] = [[None, None, None]];
         assert_eq!(choose(&none, |_| true, 0.5), None);

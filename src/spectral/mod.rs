@@ -2,6 +2,7 @@
 //! wavenumber, and the closed-form integral of the plate's Mueller matrices over them.
 
 pub mod amplitudes;
+pub mod channel;
 pub mod channels;
 pub mod fringe;
 pub mod group;

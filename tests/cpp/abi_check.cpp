@@ -128,7 +128,7 @@ int main() {
         std::printf("wide band %d %d [%s]\n", (int) rc, (int) out.status[0], std::string(s.message).c_str());
     }
     {
-        rust::Box<bfr::PlateSpectrum> srgb = bfr::channel_spectrum(bfr::ChannelSet::Srgb);
+        rust::Box<bfr::PlateSpectrum> srgb = bfr::srgb_spectrum();
         bfr::PlateLanes rgb = p;
         rgb.wavelengths_nm = {};
         Out out(n, srgb->channels(0));

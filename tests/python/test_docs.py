@@ -86,10 +86,13 @@ def source_names(path: pathlib.Path) -> tuple[set[str], set[str]]:
     source = path.read_text()
     read = r'(?:props\.\w+(?:<[^>]*>)?\(|(?:parse_ior|scalar_texture<[^>]*>)\(\s*props,\s*)\s*"(\w+)"'
     names = set(re.findall(read, source))
-    if "parse_material(props" in source:  # params.h reads the material properties
-        common = (path.parent / "params.h").read_text()
-        body = common[common.index("inline MaterialParams parse_material"):]
-        names |= set(re.findall(read, body[:body.index("\n}\n")]))
+    common = (path.parent / "params.h").read_text()
+    # The parsers of params.h read properties too: the material, the channel.
+    for call, definition in (("parse_material(props", "inline MaterialParams parse_material"),
+                             ("parse_channel<Spectrum>(props", "std::string parse_channel")):
+        if call in source:
+            body = common[common.index(definition):]
+            names |= set(re.findall(read, body[:body.index("\n}\n")]))
     exposed = set(re.findall(r'cb->put\("(\w+)"', source))
     return names, exposed
 

@@ -25,10 +25,10 @@
 #![no_main]
 
 use birefringent::ffi::bridge::{
-    ChannelSet, CrystalLanes, PlateCall, PlateLanes, Samples, Status, Transport,
+    CrystalLanes, PlateCall, PlateLanes, Samples, Status, Transport,
 };
 use birefringent::ffi::{
-    band_spectrum, channel_spectrum, exact_spectrum, new_materials, sample_crystal, sample_plate,
+    band_spectrum, colour_channel_spectrum, exact_spectrum, new_materials, sample_crystal, sample_plate, srgb_spectrum,
     Materials, PlateSpectrum,
 };
 use birefringent_fuzz::Bytes;
@@ -466,12 +466,16 @@ fn spectrum(b: &mut Bytes) -> (Box<PlateSpectrum>, bool, bool) {
     match b.u8() % 5 {
         0 => (exact_spectrum(), false, true),
         1 | 2 => (band_spectrum(b.f64()), false, true),
-        k => {
-            let set = ChannelSet {
-                repr: if k == 3 { b.u8() % 2 } else { b.u8() },
-            };
-            match channel_spectrum(set) {
-                Ok(s) => (s, set == ChannelSet::Srgb, false),
+        3 => (srgb_spectrum(), true, false),
+        _ => {
+            // Mostly valid channel names, sometimes a mangled one.
+            const NAMES: [&str; 10] = [
+                "srgb-d65:R", "srgb-d65:G", "srgb-d65:B", "xyz-d65:X", "xyz-d65:Y",
+                "xyz-d65:Z", "xyz-e:X", "xyz-e:Y", "xyz-e:Z", "srgb-d65:Y",
+            ];
+            let name = NAMES[b.u8() as usize % NAMES.len()];
+            match colour_channel_spectrum(name) {
+                Ok(s) => (s, name.starts_with("srgb"), false),
                 Err(e) => {
                     check_message(&e.to_string());
                     (exact_spectrum(), false, true)
