@@ -39,6 +39,9 @@
 #                 one core), error vs time per scene, overhead against Mitsuba's own plugins;
 #                 writes bench/results.json, bench/out/ (JSON, PNG plots) and README.md's
 #                 benchmark section (~4 min)
+#   make bench-overhead  the overhead table alone (ours against Mitsuba's own plugins, isotropic
+#                 and anisotropic scenes), merged into bench/results.json and README.md's
+#                 benchmark section; the other figures are kept
 
 SHELL := bash
 .SHELLFLAGS := -euo pipefail -c
@@ -68,7 +71,7 @@ PLUGIN_BUILT := target/release/libmitsuba_birefringent.so
 # site-packages of .venv/ (evaluated when used: the venv may not exist yet when make starts)
 SITE = $(shell $(VPY) -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')
 
-.PHONY: help setup build venv llvm plugin plugin-lib render gallery test test-rust test-python fuzz fuzz-ci bench bench-scenes bench-jit fmt lint clean distclean
+.PHONY: help setup build venv llvm plugin plugin-lib render gallery test test-rust test-python fuzz fuzz-ci bench bench-scenes bench-overhead bench-jit fmt lint clean distclean
 
 help:
 	@sed -n '3,/^$$/s/^# \{0,1\}//p' $(firstword $(MAKEFILE_LIST))
@@ -233,13 +236,21 @@ bench-jit: setup
 # examples/bench_shortcuts.rs (speed ratios of the core's shortcuts, one core), then
 # bench/scenes.py (every scene module of scenes/: error vs time against an exact
 # per-wavelength reference, cached in bench/out/ by scene + parameters; render-time overhead
-# against Mitsuba's thindielectric/dielectric), which writes bench/results.json; then
-# bench/readme.py regenerates README.md between <!-- bench:begin --> and <!-- bench:end -->.
+# against Mitsuba's thindielectric/dielectric, isotropic and anisotropic scenes), which writes
+# bench/results.json; then bench/readme.py regenerates README.md between <!-- bench:begin -->
+# and <!-- bench:end -->.
 bench-scenes: setup
 	$(CARGO) build --release --example bench_shortcuts
 	@mkdir -p $(BENCH_OUT)
 	$(TASKSET) target/release/examples/bench_shortcuts --out $(BENCH_OUT)/shortcuts.json
 	$(VPY) bench/scenes.py --out $(BENCH_OUT) --results bench/results.json
+	$(VPY) bench/readme.py bench/results.json README.md
+
+# Part 2 of bench/scenes.py alone (render-time overhead against thindielectric/dielectric, the
+# isotropic and the anisotropic rows), merged into bench/results.json; then the README section.
+bench-overhead: setup
+	@mkdir -p $(BENCH_OUT)
+	$(VPY) bench/scenes.py --only overhead --out $(BENCH_OUT) --results bench/results.json
 	$(VPY) bench/readme.py bench/results.json README.md
 
 ## ---- code quality ----------------------------------------------------------------------

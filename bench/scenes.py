@@ -3,6 +3,7 @@
 
     .venv/bin/python bench/scenes.py [--out bench/out] [--results bench/results.json]
                                      [--scenes a,b] [--repeats N] [--quick]
+                                     [--only overhead]
 
 Three parts, all measured here, in this process, with Mitsuba's default thread pool (every core
 of the machine; wall time of ``mi.render`` only, the scene loaded and rendered once beforehand):
@@ -31,22 +32,30 @@ of the machine; wall time of ``mi.render`` only, the scene loaded and rendered o
    headline figure is that ratio (mean CIEDE2000) at the method's highest-spp point whose error
    lies within the range of (a), else at its highest-spp point (flagged).
 
-2. **Overhead against Mitsuba's own plugins**: a room (diffuse walls, ceiling light) with three
-   glass panes (``thinbirefringent`` eta_o = eta_e = 1.5, 1000 um, against ``thindielectric``
-   int_ior 1.5) or with a glass sphere and cube (``birefringent`` eta_o = eta_e = 1.5 against
-   ``dielectric`` int_ior 1.5), ``path`` with max_depth 8, same spp; in scalar_rgb and
-   scalar_spectral_polarized. All configurations of a variant are rendered in turn, ``repeats``
-   rounds (interleaved), with fresh seeds; figure = median time of ours / median time of
-   Mitsuba's. The same loop times the isotropic fast path at scene level: the same scenes with
-   eta_e = 1.5 + 1e-9 (optically identical, anisotropic to the core) against eta_e = 1.5, in
-   scalar_spectral_polarized.
+2. **Overhead against Mitsuba's own plugins**: a room (diffuse walls, ceiling light), ``path``
+   with max_depth 8, with our plugin against the same room with the Mitsuba plugin a user would
+   use instead (``OVERHEAD_PAIRS``; the rooms in ``CONFIGS``). Isotropic rows (the core's fast
+   path): three glass panes (``thinbirefringent`` eta_o = eta_e = 1.5, 1000 um, against
+   ``thindielectric`` int_ior 1.5), a glass sphere and cube (``birefringent`` eta_o = eta_e =
+   1.5 against ``dielectric`` int_ior 1.5). Anisotropic rows: the three panes as quartz plates
+   (``material`` quartz) of each thickness of ``QUARTZ_UM`` between crossed ``polarizer``
+   rectangles, against ``thindielectric`` int_ior 1.544 between the same polarisers; the panes
+   as 3 mm photoelastic plates (eta_o = 1.5, ``birefringence`` 2e-4) between them, against
+   ``thindielectric`` 1.5; a calcite sphere and cube against ``dielectric`` 1.658 (polarised
+   variant only: a bulk crystal needs one). In scalar_rgb and scalar_spectral_polarized, same
+   spp. Every configuration of a variant is loaded and rendered once, then all are rendered in
+   turn, ``repeats`` rounds (interleaved), with fresh seeds; figure = median time of ours /
+   median time of Mitsuba's. The same loop times the isotropic fast path at scene level
+   (``FAST_PATH_PAIRS``): the glass scenes with eta_e = 1.5 + 1e-9 (optically identical,
+   anisotropic to the core) against eta_e = 1.5, in scalar_spectral_polarized.
+   ``--only overhead`` measures this part alone and merges it into the existing results.
 
 3. **Shortcuts**: the core-level ratios of ``examples/bench_shortcuts.rs`` (read from
    ``bench/out/shortcuts.json``, which ``make bench-scenes`` writes first) plus the scene-level
    isotropic ratios of part 2: every case (``shortcut_cases``) and one headline case each
    (``shortcuts``).
 
-Writes ``bench/results.json`` (the summary: ``overhead_vs_mitsuba``,
+Writes ``bench/results.json`` (the summary: ``overhead`` with its own date and load,
 ``analytic_speedup_at_equal_error``, ``shortcuts``, ``shortcut_cases``, the machine and the date),
 ``bench/out/scenes.json`` (every measurement) and one PNG per scene
 (``bench/out/error_vs_time-<scene>.png``). ``bench/readme.py`` turns the results into the README
@@ -67,6 +76,7 @@ import platform
 import statistics
 import sys
 import time
+import typing
 import warnings
 
 import numpy as np
@@ -384,11 +394,37 @@ def room(mi, objects: dict) -> dict:
     return d
 
 
-def panes(mi, bsdf: dict) -> dict:
+#: Where the three panes of `panes` stand: centre (x, y) and rotation about z (degrees).
+PANES = ((-0.9, 0.3, 20), (0.0, -0.4, -10), (0.9, 0.5, 35))
+
+
+def pane_frame(mi, i: int):
+    """World transform of pane `i`: a rectangle 1 x 1.4 standing upright, its normal (local z)
+    towards the camera's side, its local x axis (the shading frame's dp/du) horizontal."""
     T = mi.ScalarTransform4f
-    return {f"pane{i}": {"type": "rectangle", "bsdf": bsdf,
-                         "to_world": T().translate([x, y, 0.8]).rotate([0, 0, 1], a).rotate([1, 0, 0], 90).scale([0.5, 0.7, 1])}
-            for i, (x, y, a) in enumerate(((-0.9, 0.3, 20), (0.0, -0.4, -10), (0.9, 0.5, 35)))}
+    x, y, a = PANES[i]
+    return T().translate([x, y, 0.8]).rotate([0, 0, 1], a).rotate([1, 0, 0], 90).scale([0.5, 0.7, 1])
+
+
+def panes(mi, bsdf: dict) -> dict:
+    return {f"pane{i}": {"type": "rectangle", "bsdf": bsdf, "to_world": pane_frame(mi, i)}
+            for i in range(len(PANES))}
+
+
+def between_polarizers(mi, bsdf: dict) -> dict:
+    """The three panes of `panes` with `bsdf`, each between crossed linear polarisers: Mitsuba's
+    `polarizer` on rectangles 3 cm in front of and behind the pane, in its frame moved along
+    its normal (so the same local x axis). They transmit at -45 and +45 degrees to that axis,
+    along which a plate's optic axis lies by default ([1, 0, 0]): the arrangement of strongest
+    interference colours. In unpolarised variants a `polarizer` is a grey filter of 0.5."""
+    T = mi.ScalarTransform4f
+    d = panes(mi, bsdf)
+    for i in range(len(PANES)):
+        # Mitsuba's polarizer transmits along -theta (see scenes/_common.py).
+        for side, offset, theta in (("front", 0.03, 45.0), ("back", -0.03, -45.0)):
+            d[f"{side}_polarizer{i}"] = {"type": "rectangle", "bsdf": {"type": "polarizer", "theta": theta},
+                                         "to_world": pane_frame(mi, i) @ T().translate([0, 0, offset])}
+    return d
 
 
 def solids(mi, bsdf: dict) -> dict:
@@ -398,42 +434,173 @@ def solids(mi, bsdf: dict) -> dict:
                      "to_world": T().translate([0.7, 0.3, 0.45]).rotate([0, 0, 1], 30).scale(0.42)}}
 
 
+def plate(**params) -> dict:
+    return {"type": "thinbirefringent", "ext_ior": 1.0, **params}
+
+
+def crystal(**params) -> dict:
+    return {"type": "birefringent", "ext_ior": 1.0, **params}
+
+
+def mitsuba_bsdf(plugin: str, int_ior: float) -> dict:
+    return {"type": plugin, "int_ior": int_ior, "ext_ior": 1.0}
+
+
+#: Thicknesses (um) of the quartz plates between crossed polarisers.
+QUARTZ_UM = (0, 5, 20, 50, 100, 150)
+#: The index Mitsuba's plugins get in place of quartz (its ordinary index, 1.544 at 589 nm) and
+#: of calcite (1.658); a user picks these for the isotropic stand-in.
+QUARTZ_N_O, CALCITE_N_O = 1.544, 1.658
+
+#: Every room configuration of the overhead benchmark: name -> the room's objects (given `mi`).
+#: "aniso_1e-9": eta_e = 1.5 + 1e-9, optically the same glass but anisotropic to the core.
+CONFIGS = {
+    "glass_panes/thindielectric": lambda mi: panes(mi, mitsuba_bsdf("thindielectric", 1.5)),
+    "glass_panes/thinbirefringent": lambda mi: panes(mi, plate(eta_o=1.5, eta_e=1.5, thickness=1000.0)),
+    "glass_panes/thinbirefringent_aniso_1e-9": lambda mi: panes(
+        mi, plate(eta_o=1.5, eta_e=1.5 + 1e-9, thickness=1000.0)),
+    "glass_solids/dielectric": lambda mi: solids(mi, mitsuba_bsdf("dielectric", 1.5)),
+    "glass_solids/birefringent": lambda mi: solids(mi, crystal(eta_o=1.5, eta_e=1.5)),
+    "glass_solids/birefringent_aniso_1e-9": lambda mi: solids(mi, crystal(eta_o=1.5, eta_e=1.5 + 1e-9)),
+    "quartz_plates/thindielectric": lambda mi: between_polarizers(mi, mitsuba_bsdf("thindielectric", QUARTZ_N_O)),
+    **{f"quartz_plates/thinbirefringent_{d}um": (lambda d: lambda mi: between_polarizers(
+        mi, plate(material="quartz", thickness=float(d))))(d) for d in QUARTZ_UM},
+    "photoelastic_plates/thindielectric": lambda mi: between_polarizers(mi, mitsuba_bsdf("thindielectric", 1.5)),
+    "photoelastic_plates/thinbirefringent_3mm": lambda mi: between_polarizers(
+        mi, plate(eta_o=1.5, eta_e=1.5, birefringence=2e-4, thickness=3000.0)),
+    "calcite_solids/dielectric": lambda mi: solids(mi, mitsuba_bsdf("dielectric", CALCITE_N_O)),
+    "calcite_solids/birefringent": lambda mi: solids(
+        mi, crystal(material="calcite", optic_axis=[1.0, 1.0, 1.0], optic_axis_space="world")),
+}
+
+
+class Pair(typing.NamedTuple):
+    """Two configurations (keys of CONFIGS) timed against each other, interleaved: the figure is
+    the median time of `ours` over that of `theirs`, in each of `variants`."""
+    kind: str  # of `ours`: "isotropic" (eta_o == eta_e: the core's fast path) or "anisotropic"
+    ours: str
+    theirs: str
+    variants: tuple[str, ...]
+    what: str  # the scene, in words (the README's row)
+
+    @property
+    def plugin(self) -> str:
+        """Our plugin in `ours` (configuration names are "<scene>/<plugin>[_<detail>]")."""
+        return self.ours.split("/")[1].split("_")[0]
+
+
+BOTH = OVERHEAD_VARIANTS
+#: A bulk birefringent crystal needs a polarised variant (plugin/README.md).
+POLARIZED = ("scalar_spectral_polarized",)
+#: The rows of the overhead table: ours against the Mitsuba plugin a user would use instead, in
+#: the same room, with the same spp and variant.
+OVERHEAD_PAIRS = {
+    "isotropic/glass_panes": Pair(
+        "isotropic", "glass_panes/thinbirefringent", "glass_panes/thindielectric", BOTH,
+        "3 glass panes (eta_o = eta_e = 1.5, 1000 um) vs `thindielectric` 1.5"),
+    "isotropic/glass_solids": Pair(
+        "isotropic", "glass_solids/birefringent", "glass_solids/dielectric", BOTH,
+        "glass sphere and cube (eta_o = eta_e = 1.5) vs `dielectric` 1.5"),
+    **{f"anisotropic/quartz_plates_{d}um": Pair(
+        "anisotropic", f"quartz_plates/thinbirefringent_{d}um", "quartz_plates/thindielectric", BOTH,
+        f"3 quartz plates of {d} um between crossed polarisers vs `thindielectric` {QUARTZ_N_O}")
+       for d in QUARTZ_UM},
+    "anisotropic/photoelastic_plates_3mm": Pair(
+        "anisotropic", "photoelastic_plates/thinbirefringent_3mm", "photoelastic_plates/thindielectric", BOTH,
+        "3 photoelastic plates (eta_o = 1.5, birefringence 2e-4, 3 mm) between crossed polarisers "
+        "vs `thindielectric` 1.5"),
+    "anisotropic/calcite_solids": Pair(
+        "anisotropic", "calcite_solids/birefringent", "calcite_solids/dielectric", POLARIZED,
+        f"calcite sphere and cube (optic axis [1, 1, 1] in world space) vs `dielectric` {CALCITE_N_O}"),
+}
+#: The isotropic fast path at scene level: ours with eta_e = 1.5 + 1e-9 against ours with 1.5.
+FAST_PATH_PAIRS = {
+    "isotropic_fast_path_thin": Pair(
+        "anisotropic", "glass_panes/thinbirefringent_aniso_1e-9", "glass_panes/thinbirefringent",
+        POLARIZED, "3 glass panes, eta_e = 1.5 + 1e-9 vs 1.5"),
+    "isotropic_fast_path_bulk": Pair(
+        "anisotropic", "glass_solids/birefringent_aniso_1e-9", "glass_solids/birefringent",
+        POLARIZED, "glass sphere and cube, eta_e = 1.5 + 1e-9 vs 1.5"),
+}
+
+
 def overhead(repeats: int) -> dict:
-    thin = lambda e: {"type": "thinbirefringent", "eta_o": 1.5, "eta_e": e, "ext_ior": 1.0,
-                      "thickness": 1000.0}
-    bulk = lambda e: {"type": "birefringent", "eta_o": 1.5, "eta_e": e, "ext_ior": 1.0}
-    configs = {
-        "thindielectric": lambda mi: panes(mi, {"type": "thindielectric", "int_ior": 1.5, "ext_ior": 1.0}),
-        "thinbirefringent": lambda mi: panes(mi, thin(1.5)),
-        "thinbirefringent_aniso": lambda mi: panes(mi, thin(1.5 + 1e-9)),
-        "dielectric": lambda mi: solids(mi, {"type": "dielectric", "int_ior": 1.5, "ext_ior": 1.0}),
-        "birefringent": lambda mi: solids(mi, bulk(1.5)),
-        "birefringent_aniso": lambda mi: solids(mi, bulk(1.5 + 1e-9)),
-    }
+    """Every pair of OVERHEAD_PAIRS and FAST_PATH_PAIRS in each of OVERHEAD_VARIANTS: every
+    configuration a variant needs loaded and warmed up, then `repeats` rounds in which each is
+    rendered once (fresh seeds per round)."""
+    pairs = {**OVERHEAD_PAIRS, **FAST_PATH_PAIRS}
     out = {}
     for variant in OVERHEAD_VARIANTS:
         mi = set_variant(variant)
+        here = {k: p for k, p in pairs.items() if variant in p.variants}
+        names = list(dict.fromkeys(n for p in here.values() for n in (p.theirs, p.ours)))
         scenes = {}
-        for name, objects in configs.items():
-            if name.endswith("_aniso") and "polarized" not in variant:
-                continue  # an anisotropic bulk crystal needs a polarised variant; the thin
-                # plate's scene-level shortcut is timed in the polarised variant only
-            scenes[name] = mi.load_dict(room(mi, objects(mi)))
+        for name in names:
+            scenes[name] = mi.load_dict(room(mi, CONFIGS[name](mi)))
             mi.render(scenes[name], spp=1, seed=0)  # warm-up
         times = {name: [] for name in scenes}
         for rep in range(repeats):
             for name, scene in scenes.items():
                 times[name].append(render(mi, scene, OVERHEAD_SPP, seed=10 * rep + 1)[1])
         med = {name: statistics.median(t) for name, t in times.items()}
-        ratios = {"thinbirefringent": med["thinbirefringent"] / med["thindielectric"],
-                  "birefringent": med["birefringent"] / med["dielectric"]}
-        if "birefringent_aniso" in med:
-            ratios["isotropic_fast_path_thin"] = med["thinbirefringent_aniso"] / med["thinbirefringent"]
-            ratios["isotropic_fast_path_bulk"] = med["birefringent_aniso"] / med["birefringent"]
-        print(f"overhead, {variant}: " + ", ".join(f"{k} {v:.2f} s" for k, v in med.items()))
-        print("  ratios: " + ", ".join(f"{k} {v:.3f}" for k, v in ratios.items()))
+        ratios = {k: med[p.ours] / med[p.theirs] for k, p in here.items()}
+        print(f"overhead, {variant} (median s):")
+        for name, t in med.items():
+            print(f"  {name:48s} {t:8.3f}")
+        print("  ratios:")
+        for k, r in ratios.items():
+            print(f"  {k:48s} {r:8.2f}")
         out[variant] = {"median_seconds": med, "seconds": times, "ratios": ratios}
     return out
+
+
+def now() -> str:
+    return datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+
+
+def overhead_summary(over: dict, repeats: int, measured: dict) -> dict:
+    """results.json's "overhead": how it was measured, and per row of OVERHEAD_PAIRS its kind,
+    scene and ratio ours / Mitsuba's per variant."""
+    rows = {k: {"kind": p.kind, "plugin": p.plugin, "what": p.what, "ours": p.ours, "theirs": p.theirs,
+                "ratio": {v: over[v]["ratios"][k] for v in p.variants}}
+            for k, p in OVERHEAD_PAIRS.items()}
+    settings = {"size": OVERHEAD_SIZE, "spp": OVERHEAD_SPP, "repeats": repeats,
+                "integrator": "path, max_depth 8", "variants": list(OVERHEAD_VARIANTS)}
+    return {"measured": measured, "settings": settings, "rows": rows}
+
+
+def scene_shortcuts(over: dict) -> dict:
+    """The scene-level ratios of FAST_PATH_PAIRS, keyed as results.json's "shortcut_cases"."""
+    polarized = over["scalar_spectral_polarized"]["ratios"]
+    return {"isotropic_fast_path/scene_thin": polarized["isotropic_fast_path_thin"],
+            "isotropic_fast_path/scene_bulk": polarized["isotropic_fast_path_bulk"]}
+
+
+def shortcut_summary(core_shortcuts: dict | None, over: dict) -> tuple[dict, dict]:
+    """results.json's "shortcuts" (one headline case each) and "shortcut_cases" (every case):
+    the core's, from examples/bench_shortcuts.rs, and the scene-level ones of `over`."""
+    scene = scene_shortcuts(over)
+    shortcuts = dict(core_shortcuts["headline"]) if core_shortcuts else {}
+    shortcuts["isotropic_fast_path_scene_thin"] = scene["isotropic_fast_path/scene_thin"]
+    shortcuts["isotropic_fast_path_scene_bulk"] = scene["isotropic_fast_path/scene_bulk"]
+    cases = {k: c["ratio"] for k, c in core_shortcuts["cases"].items()} if core_shortcuts else {}
+    return shortcuts, {**cases, **scene}
+
+
+def merge_overhead(results_path: pathlib.Path, detail_path: pathlib.Path, over: dict,
+                   summary: dict) -> tuple[dict, dict]:
+    """`--only overhead`: the existing results and detail with the overhead figures (and the
+    scene-level shortcut ratios they contain) replaced; everything else is kept as measured."""
+    if not results_path.exists():
+        raise SystemExit(f"{results_path}: no results to merge into; run without --only first")
+    results = json.loads(results_path.read_text())
+    results["overhead"] = summary
+    shortcuts, cases = shortcut_summary(None, over)  # the scene-level ones only
+    results["shortcuts"] = {**results.get("shortcuts", {}), **shortcuts}
+    results["shortcut_cases"] = {**results.get("shortcut_cases", {}), **cases}
+    detail = json.loads(detail_path.read_text()) if detail_path.exists() else {}
+    detail["overhead"] = over
+    return results, detail
 
 
 def main() -> int:
@@ -443,6 +610,9 @@ def main() -> int:
     p.add_argument("--shortcuts", type=pathlib.Path, default=None,
                    help="JSON of examples/bench_shortcuts.rs (default OUT/shortcuts.json)")
     p.add_argument("--scenes", default=None, help="comma-separated scene names (default: all)")
+    p.add_argument("--only", choices=("overhead",), default=None,
+                   help="measure the overhead table alone and merge it into RESULTS (and "
+                        "OUT/scenes.json), keeping the other figures")
     p.add_argument("--repeats", type=int, default=OVERHEAD_REPEATS)
     p.add_argument("--quick", action="store_true",
                    help="tiny budgets to check that the script runs (figures meaningless)")
@@ -457,47 +627,43 @@ def main() -> int:
     warnings.filterwarnings("ignore", module="colour")
     started = time.perf_counter()
     load_before = load_average()
-
-    modules = discover(a.scenes.split(",") if a.scenes else None)
-    scenes = {name: error_vs_time(name, m, a.out) for name, m in modules.items()}
-    over = overhead(a.repeats)
-    shortcuts_path = a.shortcuts or a.out / "shortcuts.json"
-    core_shortcuts = json.loads(shortcuts_path.read_text()) if shortcuts_path.exists() else None
-
-    polarized = over["scalar_spectral_polarized"]["ratios"]
-    shortcuts = dict(core_shortcuts["headline"]) if core_shortcuts else {}
-    shortcuts["isotropic_fast_path_scene_thin"] = polarized["isotropic_fast_path_thin"]
-    shortcuts["isotropic_fast_path_scene_bulk"] = polarized["isotropic_fast_path_bulk"]
-    # Every measured case of every shortcut (the headline above is one chosen case each).
-    shortcut_cases = ({k: c["ratio"] for k, c in core_shortcuts["cases"].items()}
-                      if core_shortcuts else {})
-    shortcut_cases["isotropic_fast_path/scene_thin"] = polarized["isotropic_fast_path_thin"]
-    shortcut_cases["isotropic_fast_path/scene_bulk"] = polarized["isotropic_fast_path_bulk"]
     import mitsuba as mi
 
-    results = {
-        "date": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
-        "machine": dict(machine(), load_average_start=load_before, load_average_end=load_average()),
-        "mitsuba": mi.__version__,
-        "overhead_vs_mitsuba": {"thinbirefringent": polarized["thinbirefringent"],
-                                "birefringent": polarized["birefringent"]},
-        "overhead_vs_mitsuba_by_variant": {v: {k: over[v]["ratios"][k]
-                                               for k in ("thinbirefringent", "birefringent")}
-                                           for v in over},
-        "analytic_speedup_at_equal_error": {n: r["headline"]["ratio"] for n, r in scenes.items()},
-        "equal_error_detail": {n: r["headline"] for n, r in scenes.items()},
-        "shortcuts": shortcuts,
-        "shortcut_cases": shortcut_cases,
-        "settings": {"overhead": {"size": OVERHEAD_SIZE, "spp": OVERHEAD_SPP,
-                                  "repeats": a.repeats, "integrator": "path, max_depth 8"},
-                     "reference_spp": REFERENCE_SPP, "spp": SPP, "scene_budgets": SCENE_BUDGETS,
-                     "frames": {n: frame(n) for n in scenes}},
-        "bench_seconds": time.perf_counter() - started,
-    }
-    detail = {"scenes": scenes, "overhead": over, "core_shortcuts": core_shortcuts}
-    (a.out / "scenes.json").write_text(json.dumps(detail, indent=1))
+    scenes = {}
+    if a.only is None:
+        modules = discover(a.scenes.split(",") if a.scenes else None)
+        scenes = {name: error_vs_time(name, m, a.out) for name, m in modules.items()}
+    overhead_started, overhead_load = time.perf_counter(), load_average()
+    over = overhead(a.repeats)
+    summary = overhead_summary(over, a.repeats, {
+        "date": now(), "cpu": machine()["cpu"], "logical_cores": machine()["logical_cores"],
+        "load_average_start": overhead_load, "load_average_end": load_average(),
+        "seconds": time.perf_counter() - overhead_started,
+        "command": "bench/scenes.py" + (" --only overhead" if a.only else "")})
+    detail_path = a.out / "scenes.json"
+    if a.only == "overhead":
+        results, detail = merge_overhead(a.results, detail_path, over, summary)
+    else:
+        shortcuts_path = a.shortcuts or a.out / "shortcuts.json"
+        core_shortcuts = json.loads(shortcuts_path.read_text()) if shortcuts_path.exists() else None
+        shortcuts, shortcut_cases = shortcut_summary(core_shortcuts, over)
+        results = {
+            "date": now(),
+            "machine": dict(machine(), load_average_start=load_before, load_average_end=load_average()),
+            "mitsuba": mi.__version__,
+            "overhead": summary,
+            "analytic_speedup_at_equal_error": {n: r["headline"]["ratio"] for n, r in scenes.items()},
+            "equal_error_detail": {n: r["headline"] for n, r in scenes.items()},
+            "shortcuts": shortcuts,
+            "shortcut_cases": shortcut_cases,
+            "settings": {"reference_spp": REFERENCE_SPP, "spp": SPP, "scene_budgets": SCENE_BUDGETS,
+                         "frames": {n: frame(n) for n in scenes}},
+            "bench_seconds": time.perf_counter() - started,
+        }
+        detail = {"scenes": scenes, "overhead": over, "core_shortcuts": core_shortcuts}
+    detail_path.write_text(json.dumps(detail, indent=1))
     a.results.write_text(json.dumps(results, indent=2) + "\n")
-    print(f"wrote {a.results} and {a.out / 'scenes.json'} in {results['bench_seconds']:.0f} s")
+    print(f"wrote {a.results} and {detail_path} in {time.perf_counter() - started:.0f} s")
     return 0
 
 

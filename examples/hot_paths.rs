@@ -13,7 +13,9 @@
 //! plate in a 4 nm band, a 0.5 um lithium niobate film in sRGB: in air, and as in the thin_film
 //! scene, x-cut on black silica, `plate_film_scene_rgb`; the four exact wavelengths of one path
 //! of a spectral variant through a 20 um quartz plate, `plate_quartz_4exact`, and through a 3 mm
-//! photoelastic plate, `plate_stress_4exact`). Directions: 64 on a spiral up
+//! photoelastic plate, `plate_stress_4exact`; in sRGB, the quartz plates of 0, 5 and 150 um and
+//! the 3 mm photoelastic plate of the overhead benchmark, `plate_quartz0_rgb`,
+//! `plate_quartz5_rgb`, `plate_quartz150_rgb`, `plate_stress_rgb`). Directions: 64 on a spiral up
 //! to `THETA_MAX` degrees from the normal (default 45, the directions plugin/README.md's counts
 //! are quoted for).
 
@@ -129,6 +131,22 @@ fn main() {
                 "plate_quartz_rgb" => (
                     Material::named("quartz", 0.0, 0.0).unwrap(),
                     2e4,
+                    Spectrum::Weights(WeightSet::SrgbD65),
+                ),
+                // The quartz plates and the 3 mm photoelastic plate of the overhead benchmark's
+                // anisotropic rows (bench/scenes.py), as scalar_rgb asks for them.
+                "plate_quartz0_rgb" | "plate_quartz5_rgb" | "plate_quartz150_rgb" => (
+                    Material::named("quartz", 0.0, 0.0).unwrap(),
+                    match case {
+                        "plate_quartz0_rgb" => 0.0,
+                        "plate_quartz5_rgb" => 5e3,
+                        _ => 1.5e5,
+                    },
+                    Spectrum::Weights(WeightSet::SrgbD65),
+                ),
+                "plate_stress_rgb" => (
+                    Material::constant(c(1.5), c(1.5002)).unwrap(),
+                    3e6,
                     Spectrum::Weights(WeightSet::SrgbD65),
                 ),
                 "plate_quartz60_band" => (
