@@ -106,15 +106,12 @@ template <typename F> auto core_call(const char *ClassName, F &&f) -> decltype(f
     }
 }
 
-/// The default `channel` of the mono variants: the luminance (CIE 1931 Y under D65).
-inline constexpr const char *DefaultChannel = "xyz-d65:Y";
-
 /// `channel` (string): which colour channel a mono variant renders (the core checks the name).
 /// The other variants have their own channels (RGB, or wavelengths), so it is refused there.
 template <typename Spectrum>
 std::string parse_channel(const Properties &props, const char *ClassName) {
     if constexpr (is_monochromatic_v<Spectrum>) {
-        return props.get<std::string>("channel", DefaultChannel);
+        return props.get<std::string>("channel", std::string(bfr::default_channel()));
     } else {
         if (props.has_property("channel"))
             Throw("\"channel\" selects the colour channel of a mono variant's render (e.g. "
@@ -122,7 +119,7 @@ std::string parse_channel(const Properties &props, const char *ClassName) {
                   "channel in llvm_ad_mono_polarized); in this variant the %s",
                   is_spectral_v<Spectrum> ? "plate is evaluated at each sampled wavelength"
                                           : "plate is integrated over the three sRGB channels");
-        return DefaultChannel;
+        return std::string(bfr::default_channel());
     }
 }
 

@@ -29,9 +29,12 @@ import numpy as np
 #: The plugins of this package (their parameters are physical scalars: never rewritten).
 PLUGIN_TYPES = ("thinbirefringent", "birefringent")
 
-#: Mitsuba 3.9.1's emitter plugins.
+#: Mitsuba 3.9.1's emitter plugins whose spectrum a scene gives (a texture or spectrum).
 EMITTER_TYPES = ("area", "point", "spot", "constant", "envmap", "directional", "directionalarea",
-                 "projector", "sunsky")
+                 "projector")
+
+#: The properties of those emitters that hold their spectrum.
+EMITTER_SPECTRA = ("radiance", "intensity", "irradiance")
 
 #: Spectrum plugins whose values are RGB colours.
 RGB_TYPES = ("rgb", "srgb")
@@ -61,7 +64,7 @@ class ChannelScene:
     def _node(self, node: Any, path: str, emitter: bool) -> Any:
         if isinstance(node, dict):
             return self._dict(node, path, emitter)
-        if isinstance(node, mi.ScalarColor3f):
+        if mi.variant() is not None and isinstance(node, mi.ScalarColor3f):  # none without one
             return self._value(np.array(node), path, emitter)
         if emitter and isinstance(node, (int, float)) and not isinstance(node, bool):
             self._check_d65_emitter(path, "a float (D65 times the value)")
@@ -99,14 +102,17 @@ class ChannelScene:
             return self._bitmap(node, path, emitter)
         if kind == "envmap":
             return self._envmap(node, path)
+        if kind == "sunsky":
+            raise ValueError(f"{path}: a sunsky emitter's spectrum is not the white of any "
+                             "channel weights; use an envmap or constant emitter")
         if kind == "specfilm":
             raise ValueError(f"{path}: a specfilm's bands are not colour channels; the channel "
                              "render needs an hdrfilm")
         if "film" in node and "srf" in node:
             raise ValueError(f"{path}: a sensor response (srf) is replaced by the channel "
                              "weights in a channel render; remove it")
-        inner = emitter or kind in EMITTER_TYPES
-        out = {key: self._node(value, f"{path}.{key}", inner or key == "emitter")
+        spectra = kind in EMITTER_TYPES
+        out = {key: self._node(value, f"{path}.{key}", emitter or spectra and key in EMITTER_SPECTRA)
                for key, value in node.items()}
         if kind == "hdrfilm":
             out["pixel_format"] = "luminance"  # a mono variant's film has one channel

@@ -24,7 +24,7 @@ pub use batch::{sample_crystal, sample_plate};
 pub use materials::{new_materials, Materials};
 pub use spectrum::{
     band_spectrum, channels_to_linear_srgb, colour_channel_spectrum, colour_channel_wavelength,
-    exact_spectrum, srgb_spectrum, PlateSpectrum,
+    default_channel, exact_spectrum, srgb_spectrum, PlateSpectrum,
 };
 
 /// The library's version.
@@ -213,6 +213,8 @@ pub mod bridge {
         /// plugins' `channel` parameter: `srgb-d65` R, G, B; `xyz-d65` or `xyz-e` X, Y, Z; no
         /// wavelengths): the mono variants, one channel per render.
         fn colour_channel_spectrum(name: &str) -> Result<Box<PlateSpectrum>>;
+        /// The plugins' default `channel` in the mono variants: `"xyz-d65:Y"`, the luminance.
+        fn default_channel() -> &'static str;
         /// The wavelength (nm) at which a render of channel `name` evaluates a bulk crystal
         /// (its refraction's directions depend on the wavelength): the channel's mean.
         fn colour_channel_wavelength(name: &str) -> Result<f64>;

@@ -40,6 +40,11 @@ pub fn colour_channel_spectrum(name: &str) -> Result<Box<PlateSpectrum>> {
     Ok(Box::new(PlateSpectrum::Channel(parse_channel(name)?)))
 }
 
+/// The plugins' default `channel` in the mono variants (the luminance).
+pub fn default_channel() -> &'static str {
+    channel::DEFAULT_CHANNEL
+}
+
 /// The wavelength (nm) at which a channel render evaluates a bulk crystal, whose refraction
 /// cannot be integrated over the channel: the channel's mean wavelength
 /// ([`Channel::mean_wavelength_nm`]).

@@ -4,6 +4,9 @@
 use super::weights::{self, white_scale, WeightSet};
 use super::weights_data as data;
 
+/// The name of [`Channel::LUMINANCE`]: the plugins' default `channel` in the mono variants.
+pub const DEFAULT_CHANNEL: &str = "xyz-d65:Y";
+
 /// Channel `index` (0, 1, 2) of a weight set, named `"<set>:<channel>"`, e.g. `"srgb-d65:R"`
 /// or `"xyz-d65:Y"`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -16,7 +19,7 @@ pub struct Channel {
 
 impl Channel {
     /// CIE 1931 Y under D65: the luminance of the sRGB channels (the default of the mono
-    /// variants).
+    /// variants, named [`DEFAULT_CHANNEL`]).
     pub const LUMINANCE: Channel = Channel {
         set: WeightSet::XyzD65,
         index: 1,
@@ -91,7 +94,7 @@ mod tests {
         for name in Channel::all_names() {
             assert_eq!(Channel::parse(&name).unwrap().name(), name);
         }
-        assert_eq!(Channel::parse("xyz-d65:Y"), Some(Channel::LUMINANCE));
+        assert_eq!(Channel::parse(DEFAULT_CHANNEL), Some(Channel::LUMINANCE));
         for bad in [
             "xyz-d65",
             "xyz-d65:R",

@@ -191,6 +191,16 @@ def test_emitter_spectra_outside_the_weights_are_refused(weights, emitter, messa
         pass_of(scene, weights)
 
 
+def test_only_an_emitters_spectrum_is_checked():
+    """A spot's angles and an envmap's scale are not spectra: accepted with any weights."""
+    scene = {"type": "scene",
+             "spot": {"type": "spot", "cutoff_angle": 20.0, "beam_width": 15.0,
+                      "intensity": {"type": "uniform", "value": 3.0}}}
+    assert pass_of(scene, "xyz-e")["spot"]["cutoff_angle"] == 20.0
+    with pytest.raises(ValueError, match="scene.sky: a sunsky"):
+        pass_of({"type": "scene", "sky": {"type": "sunsky"}})
+
+
 def test_emitters_of_the_weights_white_are_accepted():
     for weights, radiance, value in (("srgb-d65", {"type": "d65", "scale": 3.0}, 3.0),
                                      ("xyz-d65", 2.0, 2.0),
