@@ -6,7 +6,8 @@ bench-scenes`` runs it after bench/scenes.py).
                                          [--figure bench/analytic_vs_spectral.png] [--quick]
 
 For each scene of ``FRAMES`` (the photoelastic disk whole at 128x128 px, a 128x128 crop of the
-Michel-Levy wedge's 384x128 image: its second third, orders 2 to 4):
+Michel-Levy wedge's 384x128 image: its middle third, 40 to 80 um of quartz, first- and
+second-order colours):
 
 * the channel render, ``mitsuba_birefringent.render_analytic`` at ``SPP`` samples per pixel,
   with the scene's own (independent) sampler and with multijitter, timed as the whole call

@@ -155,14 +155,18 @@ def channel_section(r: dict) -> list[str]:
         "channel render's time. That time is the whole call: its three passes, each loading the scene "
         "and rendering it (the second of two calls at each spp: the first compiles Dr.Jit's kernels, "
         "see the first-call column; exact sampling's times are `mi.render` of a loaded scene). "
+        "Exact sampling's spp for it: the samples per pixel scalar_spectral_polarized needs for that "
+        "error (the same interpolation); the ratio is that saving in samples times the ratio of the "
+        "costs per sample. "
         "\"extrapolated\": exact sampling's curve does not reach that error within its samples, and "
         "its time is extrapolated along the curve's last measured segment (log time against log "
         f"error). Goal {goal_text('channel_render_equal_error')} at {CHANNEL_GOAL_SPP} spp in both "
         f"variants for {', '.join(CHANNEL_GOAL_SCENES)}; the other scenes have none.",
         "",
         "| scene | image | reference: spp, own error | sampler | spp | mean CIEDE2000 | time (s) | first call (s) "
-        "| scalar: time to reach it (s) | ratio | llvm: time to reach it (s) | ratio | goal |",
-        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
+        "| exact sampling's spp for it | scalar: time to reach it (s) | ratio | llvm: time to reach it (s) "
+        "| ratio | goal |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
     for scene, c in channel.items():
         ref = c["reference"]
@@ -172,7 +176,8 @@ def channel_section(r: dict) -> list[str]:
                 lines.append(
                     f"| {scene} | {image(frames.get(scene))} | {ref['spp']}, {ref['noise']['mean_de2000']:.2f} "
                     f"| {e['sampler']} | {e['spp']} | {e['mean_de2000']:.3f} | {e['seconds']:.2f} "
-                    f"| {first.get(e['spp']) or float('nan'):.2f} "
+                    f"| {first.get(e['spp']) or float('nan'):.2f} | {e['exact']['spp_at_error']:.0f}"
+                    f"{' (extrapolated)' if e['exact']['extrapolated'] else ''} "
                     f"| {at_error(e['exact'])} | {at_error(e['exact_llvm'])} | {channel_goal(scene, e)} |")
     lines += ["", "Every point of the channel render's curves (mean CIEDE2000, and time in s in brackets):", ""]
     spps = sorted({row["spp"] for c in channel.values() for m in c["at_equal_error"]

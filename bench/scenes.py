@@ -141,11 +141,12 @@ CHANNEL_METHODS = {"analytic": ("independent", (1, 2, 4, 8, 16, 32)),
                    "analytic_multijitter": ("multijitter", (1, 2, 4, 8, 16, 36))}
 #: The channel render's points at which the time of exact sampling at equal error is reported.
 CHANNEL_RATIO_SPP = (4, 16)
-#: Exact sampling and its reference for those scenes: the channel render at 16 spp lies near the
-#: error of exact sampling at a few hundred spp and below (measured in the first run: mean
-#: CIEDE2000 1.9 with multijitter at 16 spp in photoelastic_disk, which exact sampling reaches
-#: near 300 spp), so exact sampling runs to 1024 spp; a reference of 8192 spp has an own error
-#: near 0.3 there (its passes' spread, reported per scene).
+#: Exact sampling and its reference for those scenes: the channel render at 16 spp has the
+#: error of exact sampling at 50 to 2400 spp (measured, bench/results.json: photoelastic_disk
+#: mean CIEDE2000 4.1 with the independent sampler, ~50 spp of exact sampling; 1.8 with
+#: multijitter, ~270 spp; waveplates 0.74 with multijitter, ~2400 spp, the one point beyond
+#: 1024 spp), so exact sampling runs to 1024 spp; a reference of 8192 spp has an own error of
+#: 0.18 to 0.39 there (the spread of its passes, reported per scene).
 for _name in CHANNEL_SCENES:
     SCENE_BUDGETS[_name] = {"exact": (1, 4, 16, 64, 256, 1024), "reference_spp": 8192}
 #: The llvm variant of exact sampling (evaluated mode), in passes of at most this many spp (a
@@ -378,7 +379,9 @@ def channel_render(curves: dict) -> dict:
     and each spp of CHANNEL_RATIO_SPP, the time each exact curve (``exact``: the spectral
     variant; ``exact_llvm``: llvm_ad_spectral_polarized, evaluated) needs to reach the channel
     render's error (`time_at_error`: extrapolated along the curve's last measured segment
-    where it does not reach it, and flagged), and that time over the channel render's."""
+    where it does not reach it, and flagged), and that time over the channel render's; and the
+    samples per pixel that curve needs for that error (the same interpolation in log spp): the
+    ratio is the channel render's saving in samples times the ratio of the costs per sample."""
     out = {}
     for method, (sampler, _) in CHANNEL_METHODS.items():
         rows = {r["spp"]: r for r in curves[method]}
@@ -389,8 +392,10 @@ def channel_render(curves: dict) -> dict:
                      "seconds": r["seconds"]}
             for exact in ("exact", "exact_llvm"):
                 t, extrapolated = time_at_error(curves[exact], "mean_de2000", r["mean_de2000"])
+                n, _ = time_at_error([dict(x, seconds=x["spp"]) for x in curves[exact]],
+                                     "mean_de2000", r["mean_de2000"])
                 entry[exact] = {"seconds_at_error": t, "ratio": t / r["seconds"],
-                                "extrapolated": extrapolated}
+                                "spp_at_error": n, "extrapolated": extrapolated}
             entries.append(entry)
             print(f"  {method} at {spp} spp: mean CIEDE2000 {r['mean_de2000']:.3f} in "
                   f"{r['seconds']:.2f} s; " + "; ".join(
