@@ -235,15 +235,18 @@ bench-jit: setup
 
 # examples/bench_shortcuts.rs (speed ratios of the core's shortcuts, one core), then
 # bench/scenes.py (every scene module of scenes/: error vs time against an exact
-# per-wavelength reference, cached in bench/out/ by scene + parameters; render-time overhead
-# against Mitsuba's thindielectric/dielectric, isotropic and anisotropic scenes), which writes
-# bench/results.json; then bench/readme.py regenerates README.md between <!-- bench:begin -->
-# and <!-- bench:end -->.
+# per-wavelength reference, cached in bench/out/ by scene + parameters, the channel render
+# render_analytic among the methods; render-time overhead against Mitsuba's
+# thindielectric/dielectric, isotropic and anisotropic scenes), which writes bench/results.json;
+# bench/equal_time.py (the channel render and spectral sampling at equal time:
+# bench/analytic_vs_spectral.png); then bench/readme.py regenerates README.md between
+# <!-- bench:begin --> and <!-- bench:end -->.
 bench-scenes: setup
 	$(CARGO) build --release --example bench_shortcuts
 	@mkdir -p $(BENCH_OUT)
 	$(TASKSET) target/release/examples/bench_shortcuts --out $(BENCH_OUT)/shortcuts.json
 	$(VPY) bench/scenes.py --out $(BENCH_OUT) --results bench/results.json
+	$(VPY) bench/equal_time.py --out $(BENCH_OUT) --results bench/results.json
 	$(VPY) bench/readme.py bench/results.json README.md
 
 # Part 2 of bench/scenes.py alone (render-time overhead against thindielectric/dielectric, the

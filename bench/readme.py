@@ -7,8 +7,10 @@ Replaces everything between the lines ``<!-- bench:begin -->`` and ``<!-- bench:
 README (both must be present, once each) with tables of the figures in the results file: the
 machine and date, the render-time overhead against Mitsuba's own plugins (each row labelled
 isotropic or anisotropic), the speed-up of the closed-form spectral integration (or band filter)
-at equal image error per scene, each against its goal (``GOALS``: met or not met), and every
-measured speed ratio of each of the core's shortcuts. Nothing is measured or typed here: every number comes from the JSON that ``make
+at equal image error per scene, the channel render's (``render_analytic``) at equal error and the
+equal-time figure of bench/equal_time.py, each against its goal (``GOALS``: met or not met), and
+every measured speed ratio of each of the core's shortcuts. Nothing is measured or typed here:
+every number comes from the JSON that ``make
 bench`` wrote.
 """
 
@@ -29,7 +31,13 @@ GOALS = {
     "overhead_anisotropic_plate/scalar_rgb": ("<=", 3.0),
     "overhead_anisotropic_crystal": ("<=", 2.0),
     "thin_film_rgb_equal_error": (">=", 50.0),  # the thin film's analytic RGB at equal error
+    # the channel render (render_analytic) at 16 spp against exact sampling at equal error, in
+    # scalar_spectral_polarized and in llvm_ad_spectral_polarized, for CHANNEL_GOAL_SCENES
+    "channel_render_equal_error": (">=", 50.0),
 }
+#: The scenes the channel render's goal is set for (the others are reported without one), and
+#: the channel render's spp it is judged at.
+CHANNEL_GOAL_SCENES, CHANNEL_GOAL_SPP = ("photoelastic_disk", "michel_levy"), 16
 
 # Each shortcut of examples/bench_shortcuts.rs (and bench/scenes.py's scene-level ones): what it
 # replaces, and each case it was timed on (keys of results.json's "shortcut_cases").
@@ -115,6 +123,7 @@ def section(r: dict) -> str:
             goal = f"{goal_text(g)}: {verdict(g, d['ratio'])}"
         lines.append(f"| {scene} | {image(frames.get(scene))} | {label[d['method']]} | {d['spp']} | {d['error']:.3f} | "
                      f"{d['seconds']:.2f} | {d['exact_seconds_at_error']:.2f} | {d['ratio']:.3g}{flag} | {goal} |")
+    lines += channel_section(r)
     lines += ["", "**Shortcuts** (speed of the full computation's time over the shortcut's, every case "
               "measured; below 1 the shortcut is slower there):", "",
               "| shortcut | case | speed ratio |", "| --- | --- | --- |"]
@@ -160,6 +169,99 @@ def overhead_table(o: dict) -> list[str]:
             g = overhead_goal(row, v)
             cells.append("—" if x is None else f"{x:.2f} ({goal_text(g)}: {verdict(g, x)})")
         lines.append(f"| {row['kind']} | {row['what']} | " + " | ".join(cells) + " |")
+    return lines
+
+
+def channel_section(r: dict) -> list[str]:
+    """The channel render's tables (results.json "channel_render") and the equal-time figure
+    ("equal_time", written by bench/equal_time.py); nothing when the results lack them."""
+    channel = r.get("channel_render")
+    if not channel:
+        return []
+    s = r["settings"]
+    jit = s["jit"]
+    frames = s.get("frames", {})
+    lines = [
+        "",
+        "**The channel render at equal error** (`mitsuba_birefringent.render_analytic`: one "
+        "llvm_ad_mono_polarized pass per sRGB channel, the plate integrated over each channel in closed "
+        "form), against the same exact per-wavelength reference (its own error, from the spread of its "
+        "passes, in the reference column): the time exact per-wavelength sampling needs to reach the "
+        "channel render's mean CIEDE2000, in scalar_spectral_polarized and in "
+        f"{jit['variant']} (evaluated mode, passes of {jit['samples_per_pass']} spp), divided by the "
+        "channel render's time. That time is the whole call: its three passes, each loading the scene "
+        "and rendering it (the second of two calls at each spp: the first compiles Dr.Jit's kernels, "
+        "see the first-call column; exact sampling's times are `mi.render` of a loaded scene). "
+        "Exact sampling's spp for it: the samples per pixel scalar_spectral_polarized needs for that "
+        "error (the same interpolation); the ratio is that saving in samples times the ratio of the "
+        "costs per sample. "
+        "\"extrapolated\": exact sampling's curve does not reach that error within its samples, and "
+        "its time is extrapolated along the curve's last measured segment (log time against log "
+        f"error). Goal {goal_text('channel_render_equal_error')} at {CHANNEL_GOAL_SPP} spp in both "
+        f"variants for {', '.join(CHANNEL_GOAL_SCENES)}; the other scenes have none.",
+        "",
+        "| scene | image | reference: spp, own error | sampler | spp | mean CIEDE2000 | time (s) | first call (s) "
+        "| exact sampling's spp for it | scalar: time to reach it (s) | ratio | llvm: time to reach it (s) "
+        "| ratio | goal |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
+    ]
+    for scene, c in channel.items():
+        ref = c["reference"]
+        for method, entries in c["at_equal_error"].items():
+            first = {row["spp"]: row.get("first_seconds") for row in c["curves"][method]}
+            for e in entries:
+                lines.append(
+                    f"| {scene} | {image(frames.get(scene))} | {ref['spp']}, {ref['noise']['mean_de2000']:.2f} "
+                    f"| {e['sampler']} | {e['spp']} | {e['mean_de2000']:.3f} | {e['seconds']:.2f} "
+                    f"| {first.get(e['spp']) or float('nan'):.2f} | {e['exact']['spp_at_error']:.0f}"
+                    f"{' (extrapolated)' if e['exact']['extrapolated'] else ''} "
+                    f"| {at_error(e['exact'])} | {at_error(e['exact_llvm'])} | {channel_goal(scene, e)} |")
+    lines += ["", "Every point of the channel render's curves (mean CIEDE2000, and time in s in brackets):", ""]
+    spps = sorted({row["spp"] for c in channel.values() for m in c["at_equal_error"]
+                   for row in c["curves"][m]})
+    lines += ["| scene | sampler | " + " | ".join(f"{n} spp" for n in spps) + " |",
+              "| --- | --- | " + " | ".join("---" for _ in spps) + " |"]
+    for scene, c in channel.items():
+        for method, entries in c["at_equal_error"].items():
+            rows = {row["spp"]: row for row in c["curves"][method]}
+            cells = [f"{rows[n]['mean_de2000']:.2f} ({rows[n]['seconds']:.2f})" if n in rows else "—"
+                     for n in spps]
+            lines.append(f"| {scene} | {entries[0]['sampler']} | " + " | ".join(cells) + " |")
+    lines += equal_time_section(r.get("equal_time"))
+    return lines
+
+
+def at_error(x: dict) -> str:
+    """Two cells: exact sampling's time at the channel render's error, and the ratio."""
+    flag = " (extrapolated)" if x["extrapolated"] else ""
+    return f"{x['seconds_at_error']:.2f}{flag} | {x['ratio']:.3g}{flag}"
+
+
+def channel_goal(scene: str, e: dict) -> str:
+    """The goal's verdict at CHANNEL_GOAL_SPP for CHANNEL_GOAL_SCENES: met when both ratios
+    meet it."""
+    if scene not in CHANNEL_GOAL_SCENES or e["spp"] != CHANNEL_GOAL_SPP:
+        return "—"
+    g = "channel_render_equal_error"
+    worst = min(e["exact"]["ratio"], e["exact_llvm"]["ratio"])
+    return f"{goal_text(g)}: {verdict(g, worst)}"
+
+
+def equal_time_section(t: dict | None) -> list[str]:
+    """The figure of bench/equal_time.py and what each panel took."""
+    if not t:
+        return []
+    spp = next(iter(t["scenes"].values()))["panels"][0]["spp"]
+    lines = ["", f"**At equal render time** (`bench/equal_time.py`): the channel render at {spp} spp and exact "
+             "sampling given the time of the channel render with the scene's own (independent) sampler, "
+             "against an exact reference (mean CIEDE2000 under each panel):", "",
+             f"![The channel render and exact spectral sampling at equal render time]({t['figure']})", ""]
+    for scene, d in t["scenes"].items():
+        w, h = d["frame"]["crop"][2:]
+        panels = "; ".join(f"{p['label'].replace(chr(10), ' ')} {p['spp']} spp in {p['seconds']:.1f} s: "
+                           f"{p['mean_de2000']:.2f}" for p in d["panels"])
+        lines.append(f"- {scene} ({w}x{h} px; reference {d['reference']['spp']} spp, own error "
+                     f"{d['reference']['noise']['mean_de2000']:.2f}): {panels}.")
     return lines
 
 

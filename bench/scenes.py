@@ -6,7 +6,8 @@
                                      [--only overhead]
 
 Three parts, all measured here, in this process, with Mitsuba's default thread pool (every core
-of the machine; wall time of ``mi.render`` only, the scene loaded and rendered once beforehand):
+of the machine; wall time of ``mi.render`` only, the scene loaded and rendered once beforehand,
+except for the channel render: see (d)):
 
 1. **Error vs time, per scene.** Every module of ``scenes/`` with ``scene`` and ``VARIANTS`` is
    rendered small (``SIZES``), or as a small crop of its own resolution (``CROPS``). Its
@@ -19,7 +20,16 @@ of the machine; wall time of ``mi.render`` only, the scene loaded and rendered o
    (a) ``exact``: the spectral variant, ``filter_bandwidth = 0``, at increasing spp;
    (b) ``filter``: the same with a 4 nm band (``filter_bandwidth = 4``; the default is 0);
    (c) ``rgb``: ``scalar_rgb`` (the plate integrated in closed form over the sRGB channels), if
-   the scene's ``VARIANTS`` list it.
+   the scene's ``VARIANTS`` list it;
+   and for the scenes of ``CHANNEL_SCENES``:
+   (a') ``exact_llvm``: exact sampling as (a) in ``llvm_ad_spectral_polarized`` in evaluated mode
+   (``JIT_SAMPLES_PER_PASS`` spp per pass);
+   (d) the channel render, ``mitsuba_birefringent.render_analytic`` (one llvm_ad_mono_polarized
+   pass per sRGB channel, each plate integrated over the channel in closed form), with the
+   scene's own independent sampler (``analytic``) and with multijitter
+   (``analytic_multijitter``); its time is the whole call (three passes, each loading the scene).
+   In the llvm variants each point's time is that of the second of two renders at its spp (the
+   first, whose time is kept as ``first_seconds``, compiles Dr.Jit's kernels).
    Errors against the reference: relative RMSE in linear RGB, ``sqrt(mean((x - r)^2) - v_r) /
    sqrt(mean(r^2))`` with ``v_r`` the reference's own variance per pixel (estimated from its
    passes; this removes the reference's noise from the estimate), and the mean CIEDE2000 over
@@ -30,7 +40,10 @@ of the machine; wall time of ``mi.render`` only, the scene loaded and rendered o
    bracket e_m (extrapolated along the last (or first) segment of (a) when e_m lies outside its
    measured range, and flagged ``extrapolated``); the ratio is t_a(e_m) / t_m. The scene's
    headline figure is that ratio (mean CIEDE2000) at the method's highest-spp point whose error
-   lies within the range of (a), else at its highest-spp point (flagged).
+   lies within the range of (a), else at its highest-spp point (flagged). The channel render's
+   figures (`channel_render`): at each spp of ``CHANNEL_RATIO_SPP``, the time (a) and (a') need
+   to reach its mean CIEDE2000, over its time. The reference's own error (`reference_noise`) is
+   estimated from the two halves of its passes.
 
 2. **Overhead against Mitsuba's own plugins**: a room (diffuse walls, ceiling light), ``path``
    with max_depth 8, with our plugin against the same room with the Mitsuba plugin a user would
@@ -56,7 +69,8 @@ of the machine; wall time of ``mi.render`` only, the scene loaded and rendered o
    (``shortcuts``).
 
 Writes ``bench/results.json`` (the summary: ``overhead`` with its own date and load,
-``analytic_speedup_at_equal_error``, ``shortcuts``, ``shortcut_cases``, the machine and the date),
+``analytic_speedup_at_equal_error``, ``channel_render``, ``reference_noise``, ``shortcuts``,
+``shortcut_cases``, the machine and the date),
 ``bench/out/scenes.json`` (every measurement) and one PNG per scene
 (``bench/out/error_vs_time-<scene>.png``). ``bench/readme.py`` turns the results into the README
 section.
@@ -106,13 +120,18 @@ def frame(name: str) -> dict:
     return {"size": size, "crop": [0, 0, *size]}
 
 
-def load(mi, module, name: str, spp: int, **options):
-    """The scene `name` at its benchmark frame (see `frame`), loaded."""
-    f = frame(name)
+def scene_dict(module, name: str, spp: int, fr: dict | None = None, **options) -> dict:
+    """The dict of scene `name` at frame `fr` (default: its benchmark frame, see `frame`)."""
+    f = fr or frame(name)
     d = module.scene(width=f["size"][0], height=f["size"][1], spp=spp, **options)
     x, y, w, h = f["crop"]
     d["sensor"]["film"].update(crop_offset_x=x, crop_offset_y=y, crop_width=w, crop_height=h)
-    return mi.load_dict(d)
+    return d
+
+
+def load(mi, module, name: str, spp: int, fr: dict | None = None, **options):
+    """The scene `name` at frame `fr` (default: its benchmark frame), loaded."""
+    return mi.load_dict(scene_dict(module, name, spp, fr, **options))
 #: Samples per pixel of the curves, per method; the reference has REFERENCE_SPP.
 SPP = {"exact": (1, 4, 16, 64, 256), "filter": (2, 8, 32), "rgb": (1, 2, 4, 8, 16)}
 REFERENCE_SPP, REFERENCE_PASSES = 2048, 8
@@ -121,15 +140,39 @@ REFERENCE_SPP, REFERENCE_PASSES = 2048, 8
 #: 4 spp on, and a 2048-spp reference is itself that noisy (~0.3); exact sampling there costs
 #: ~3 us per sample, so 4096 spp and a 32768-spp reference take about two minutes.
 SCENE_BUDGETS = {"thin_film": {"exact": (1, 4, 16, 64, 256, 1024, 4096), "reference_spp": 32768}}
+#: The scenes of the channel render's study (``render_analytic``; see `channel_render`).
+CHANNEL_SCENES = ("photoelastic_disk", "michel_levy", "train_window", "waveplates")
+#: The channel render's curves: method -> (sampler type, samples per pixel). ``analytic`` keeps
+#: the scenes' own sampler (independent). Its remaining noise is the plate's choice between
+#: reflection and transmission (and the pixel footprint), which a stratified sampler reduces:
+#: ``analytic_multijitter`` is the same render with Mitsuba's multijitter sampler (it keeps
+#: 1, 2, 4, 8, 16 and 36 samples exactly; 32 it rounds up to 35).
+CHANNEL_METHODS = {"analytic": ("independent", (1, 2, 4, 8, 16, 32)),
+                   "analytic_multijitter": ("multijitter", (1, 2, 4, 8, 16, 36))}
+#: The channel render's points at which the time of exact sampling at equal error is reported.
+CHANNEL_RATIO_SPP = (4, 16)
+#: Exact sampling and its reference for those scenes: the channel render at 16 spp has the
+#: error of exact sampling at 50 to 2400 spp (measured, bench/results.json: photoelastic_disk
+#: mean CIEDE2000 4.1 with the independent sampler, ~50 spp of exact sampling; 1.8 with
+#: multijitter, ~270 spp; waveplates 0.74 with multijitter, ~2400 spp, the one point beyond
+#: 1024 spp), so exact sampling runs to 1024 spp; a reference of 8192 spp has an own error of
+#: 0.18 to 0.39 there (the spread of its passes, reported per scene).
+for _name in CHANNEL_SCENES:
+    SCENE_BUDGETS[_name] = {"exact": (1, 4, 16, 64, 256, 1024), "reference_spp": 8192}
+#: The llvm variant of exact sampling (evaluated mode), in passes of at most this many spp (a
+#: whole 1024-spp render in one wavefront would hold every lane's state at once).
+JIT_VARIANT, JIT_SAMPLES_PER_PASS = "llvm_ad_spectral_polarized", 64
 #: Overhead scene: size, spp, rounds (each render a few tenths of a second, well above the
 #: timer's and the thread pool's noise).
 OVERHEAD_SIZE, OVERHEAD_SPP, OVERHEAD_REPEATS = 48, 32, 5
 
 
 def budget(name: str) -> tuple[dict, int]:
-    """Samples per pixel of the curves per method, and of the reference, for scene `name`."""
+    """Samples per pixel of the curves per method, and of the reference, for scene `name`
+    (``exact_llvm``, exact sampling in the llvm variant, has the list of ``exact``)."""
     b = SCENE_BUDGETS.get(name, {})
     spp = {m: tuple(b.get(m, v)) for m, v in SPP.items()}
+    spp["exact_llvm"] = tuple(b.get("exact_llvm", spp["exact"]))
     return spp, b.get("reference_spp", REFERENCE_SPP)
 OVERHEAD_VARIANTS = ("scalar_rgb", "scalar_spectral_polarized")
 
@@ -194,21 +237,27 @@ def plugin_digest() -> str:
     return hashlib.sha256(lib.read_bytes()).hexdigest() if lib.exists() else "none"
 
 
-def reference(name: str, module, variant: str, out: pathlib.Path) -> dict:
+def reference(name: str, module, variant: str, out: pathlib.Path, fr: dict | None = None,
+              total: int | None = None) -> dict:
+    """The exact per-wavelength reference of scene `name` at frame `fr` (default: its benchmark
+    frame) with `total` spp (default: its budget's), cached; ``"noise"`` is its own error
+    (`reference_noise`)."""
     mi = set_variant(variant)
+    fr = fr or frame(name)
+    total = total or budget(name)[1]
     key = json.dumps({"scene": name, "source": hashlib.sha256(
         pathlib.Path(module.__file__).read_bytes()).hexdigest(), "variant": variant,
-        "frame": frame(name), "spp": budget(name)[1], "passes": REFERENCE_PASSES,
+        "frame": fr, "spp": total, "passes": REFERENCE_PASSES, "format": 2,
         "mitsuba": mi.__version__, "plugin": plugin_digest()}, sort_keys=True)
     digest = hashlib.sha256(key.encode()).hexdigest()[:16]
     cache = out / f"reference-{name}-{digest}.npz"
     if cache.exists():
         data = np.load(cache)
         print(f"  reference: cached {cache.name}")
-        return {"mean": data["mean"], "var": data["var"], "seconds": float(data["seconds"]),
-                "cache": cache.name, "cached": True}
-    total = budget(name)[1]
-    scene = load(mi, module, name, total, filter_bandwidth=0.0)
+        ref = {"mean": data["mean"], "var": data["var"], "halves": data["halves"],
+               "seconds": float(data["seconds"]), "cache": cache.name, "cached": True}
+        return dict(ref, noise=reference_noise(ref))
+    scene = load(mi, module, name, total, fr, filter_bandwidth=0.0)
     spp = total // REFERENCE_PASSES
     passes, seconds = [], 0.0
     for p in range(REFERENCE_PASSES):
@@ -218,9 +267,25 @@ def reference(name: str, module, variant: str, out: pathlib.Path) -> dict:
     passes = np.array(passes)
     mean = passes.mean(axis=0)
     var = passes.var(axis=0, ddof=1) / REFERENCE_PASSES  # variance of the mean, per pixel
-    np.savez(cache, mean=mean, var=var, seconds=seconds)
+    half = REFERENCE_PASSES // 2
+    halves = np.array([passes[:half].mean(axis=0), passes[half:].mean(axis=0)])
+    np.savez(cache, mean=mean, var=var, halves=halves, seconds=seconds)
     print(f"  reference: {total} spp in {seconds:.1f} s -> {cache.name}")
-    return {"mean": mean, "var": var, "seconds": seconds, "cache": cache.name, "cached": False}
+    ref = {"mean": mean, "var": var, "halves": halves, "seconds": seconds,
+           "cache": cache.name, "cached": False}
+    return dict(ref, noise=reference_noise(ref))
+
+
+def reference_noise(ref: dict) -> dict:
+    """The reference's own error, from its passes. ``mean_de2000_halves``: mean CIEDE2000
+    between the means of its two halves of passes; each half has twice the variance of the
+    whole, their difference four times, so the whole's own error is about half of it
+    (``mean_de2000``; CIEDE2000 is close to linear in small differences). ``rel_rmse``:
+    sqrt(mean(v_r)) / sqrt(mean(r^2)), v_r its variance per pixel."""
+    a, b = ref["halves"]
+    halves = errors(b, {"mean": a, "var": np.zeros_like(a)})["mean_de2000"]
+    rel = math.sqrt(float(np.mean(ref["var"])) / float(np.mean(ref["mean"] ** 2)))
+    return {"mean_de2000_halves": halves, "mean_de2000": halves / 2, "rel_rmse": rel}
 
 
 def lab(rgb: np.ndarray, white_y: float) -> np.ndarray:
@@ -243,17 +308,112 @@ def errors(img: np.ndarray, ref: dict) -> dict:
     return {"rel_rmse": rel_rmse, "mean_de2000": float(np.mean(de))}
 
 
-def curve_with(mi, module, name, spp_list, seed0, ref, **options) -> list[dict]:
-    scene = load(mi, module, name, 1, **options)
-    render(mi, scene, 1, seed=0)  # warm-up (first queries, caches)
+def render_evaluated(mi, scene, spp: int, seed: int) -> tuple[np.ndarray, float]:
+    """`render` in an llvm variant, in evaluated mode; the time includes reading the image
+    back (which waits for Dr.Jit's last kernels)."""
+    import mitsuba_birefringent
+
+    with mitsuba_birefringent.evaluated_mode():
+        start = time.perf_counter()
+        image = np.array(mi.render(scene, spp=spp, seed=seed), dtype=np.float64)[..., :3]
+        seconds = time.perf_counter() - start
+    return image, seconds
+
+
+def curve_with(mi, module, name, spp_list, seed0, ref, jit: bool = False, **options) -> list[dict]:
+    """Error and time of scene `name` rendered at each of `spp_list` in the current variant
+    (with `jit`: an llvm variant, in evaluated mode, JIT_SAMPLES_PER_PASS spp per pass)."""
+    d = scene_dict(module, name, 1, **options)
+    if jit:
+        d["integrator"]["samples_per_pass"] = JIT_SAMPLES_PER_PASS
+    scene = mi.load_dict(d)
+    timed = render_evaluated if jit else render
+    timed(mi, scene, 1, seed=0)  # warm-up (first queries, caches)
     rows = []
     for k, spp in enumerate(spp_list):
-        img, seconds = render(mi, scene, spp, seed=seed0 + k)
-        row = {"spp": spp, "seconds": seconds, **errors(img, ref)}
-        print(f"    spp {spp:5d}: {seconds:8.2f} s  rel RMSE {row['rel_rmse']:.4f}  "
-              f"mean CIEDE2000 {row['mean_de2000']:.3f}")
-        rows.append(row)
+        first = timed(mi, scene, spp, seed=seed0 + 50 + k)[1] if jit else None
+        img, seconds = timed(mi, scene, spp, seed=seed0 + k)
+        rows.append(point(spp, seconds, img, ref, first))
     return rows
+
+
+def point(spp: int, seconds: float, img: np.ndarray, ref: dict,
+          first: float | None = None) -> dict:
+    """A point of a curve. `first`: in a JIT variant, the time of the first render at this spp
+    in the process (Dr.Jit compiles the kernels it has not seen: their code depends on the spp
+    for some samplers); the point's own time is that of a second render, with compiled
+    kernels."""
+    row = {"spp": spp, "seconds": seconds, **errors(img, ref)}
+    if first is not None:
+        row["first_seconds"] = first
+    print(f"    spp {spp:5d}: {seconds:8.2f} s  rel RMSE {row['rel_rmse']:.4f}  "
+          f"mean CIEDE2000 {row['mean_de2000']:.3f}"
+          + (f"  (first render {first:.2f} s)" if first is not None else ""))
+    return row
+
+
+def analytic_curve(module, name, sampler: str, spp_list, seed0, ref, fr: dict | None = None,
+                   keep_image: bool = False) -> tuple[list[dict], list[str]]:
+    """Error and time of ``mitsuba_birefringent.render_analytic`` on scene `name` with sampler
+    `sampler`, at each of `spp_list` (frame `fr`, default its benchmark frame; with `keep_image`
+    each row holds its ``"image"``); and the warnings it gave. The time is the whole call: its
+    three passes, each loading the scene in llvm_ad_mono_polarized and rendering it; at each spp
+    the second of two calls (`point`: the first compiles Dr.Jit's kernels)."""
+    import mitsuba_birefringent
+
+    set_variant("scalar_spectral_polarized")  # the dict is the spectral scene's
+    d = scene_dict(module, name, 1, fr, filter_bandwidth=0.0)
+    d["sensor"]["sampler"]["type"] = sampler
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        mitsuba_birefringent.render_analytic(d, spp=1, seed=0)  # the warnings it gives
+    rows = []
+    for k, spp in enumerate(spp_list):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            times = []
+            for seed in (seed0 + 50 + k, seed0 + k):  # the first compiles, the second is timed
+                start = time.perf_counter()
+                out = mitsuba_birefringent.render_analytic(d, spp=spp, seed=seed)
+                times.append(time.perf_counter() - start)
+        rgb = np.asarray(out["rgb"], dtype=np.float64)
+        rows.append(point(spp, times[1], rgb, ref, times[0]))
+        if keep_image:
+            rows[-1]["image"] = rgb
+    said = sorted({str(w.message) for w in caught})
+    return rows, said
+
+
+def channel_render(curves: dict) -> dict:
+    """The channel render's curves against exact sampling, at equal mean CIEDE2000: per method
+    and each spp of CHANNEL_RATIO_SPP, the time each exact curve (``exact``: the spectral
+    variant; ``exact_llvm``: llvm_ad_spectral_polarized, evaluated) needs to reach the channel
+    render's error (`time_at_error`: extrapolated along the curve's last measured segment
+    where it does not reach it, and flagged), and that time over the channel render's; and the
+    samples per pixel that curve needs for that error (the same interpolation in log spp): the
+    ratio is the channel render's saving in samples times the ratio of the costs per sample."""
+    out = {}
+    for method, (sampler, _) in CHANNEL_METHODS.items():
+        rows = {r["spp"]: r for r in curves[method]}
+        entries = []
+        for spp in CHANNEL_RATIO_SPP:
+            r = rows[spp]
+            entry = {"spp": spp, "sampler": sampler, "mean_de2000": r["mean_de2000"],
+                     "seconds": r["seconds"]}
+            for exact in ("exact", "exact_llvm"):
+                t, extrapolated = time_at_error(curves[exact], "mean_de2000", r["mean_de2000"])
+                n, _ = time_at_error([dict(x, seconds=x["spp"]) for x in curves[exact]],
+                                     "mean_de2000", r["mean_de2000"])
+                entry[exact] = {"seconds_at_error": t, "ratio": t / r["seconds"],
+                                "spp_at_error": n, "extrapolated": extrapolated}
+            entries.append(entry)
+            print(f"  {method} at {spp} spp: mean CIEDE2000 {r['mean_de2000']:.3f} in "
+                  f"{r['seconds']:.2f} s; " + "; ".join(
+                      f"{e} needs {entry[e]['seconds_at_error']:.2f} s (ratio "
+                      f"{entry[e]['ratio']:.3g}{', extrapolated' if entry[e]['extrapolated'] else ''})"
+                      for e in ("exact", "exact_llvm")))
+        out[method] = entries
+    return out
 
 
 def time_at_error(exact: list[dict], metric: str, target: float) -> tuple[float, bool]:
@@ -302,8 +462,11 @@ def plot(name: str, result: dict, path: pathlib.Path) -> None:
 
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.4), dpi=110)
     styles = {"exact": ("C0", "o", "(a) exact per wavelength (filter 0)"),
+              "exact_llvm": ("C2", "D", "(a) exact, llvm_ad_spectral_polarized (evaluated)"),
               "filter": ("C1", "s", "(b) band filter 4 nm"),
-              "rgb": ("C3", "*", "(c) analytic RGB (scalar_rgb)")}
+              "rgb": ("C3", "*", "(c) analytic RGB (scalar_rgb)"),
+              "analytic": ("C4", "^", "(d) render_analytic, independent (whole call)"),
+              "analytic_multijitter": ("C5", "v", "(d) render_analytic, multijitter (whole call)")}
     for ax, metric, label in ((axes[0], "mean_de2000", "mean CIEDE2000"),
                               (axes[1], "rel_rmse", "relative RMSE (linear RGB)")):
         for method, rows in result["curves"].items():
@@ -322,6 +485,13 @@ def plot(name: str, result: dict, path: pathlib.Path) -> None:
     head = result.get("headline")
     txt = (f"; {head['method']} at equal CIEDE2000: {head['ratio']:.3g}x less time"
            + (" (extrapolated)" if head["extrapolated"] else "")) if head else ""
+    channel = result.get("channel_render")
+    if channel:
+        e = next(x for x in channel["analytic"] if x["spp"] == max(CHANNEL_RATIO_SPP))
+        txt += (f"\nrender_analytic at {e['spp']} spp: exact sampling needs "
+                f"{e['exact']['ratio']:.3g}x its time (llvm: {e['exact_llvm']['ratio']:.3g}x)"
+                + (" (extrapolated)" if e["exact"]["extrapolated"] or e["exact_llvm"]["extrapolated"]
+                   else ""))
     x, y, w, h = result["frame"]["crop"]
     full = result["frame"]["size"]
     where = (f"{w}x{h} px" if [w, h] == full else
@@ -350,20 +520,47 @@ def error_vs_time(name: str, module, out: pathlib.Path) -> dict:
         mi = set_variant("scalar_rgb")
         print("  (c) scalar_rgb")
         curves["rgb"] = curve_with(mi, module, name, spp["rgb"], 300, ref)
+    said = {}
+    if name in CHANNEL_SCENES:
+        mi = set_variant(JIT_VARIANT)
+        print(f"  (a) exact, {JIT_VARIANT} (evaluated mode)")
+        curves["exact_llvm"] = curve_with(mi, module, name, spp["exact_llvm"], 400, ref,
+                                          jit=True, filter_bandwidth=0.0)
+        for k, (method, (sampler, spp_list)) in enumerate(CHANNEL_METHODS.items()):
+            print(f"  (d) render_analytic, {sampler} sampler")
+            curves[method], said[method] = analytic_curve(module, name, sampler, spp_list,
+                                                          500 + 100 * k, ref)
     ratios = {m: {metric: equal_error(curves["exact"], curves[m], metric)
                   for metric in ("mean_de2000", "rel_rmse")}
               for m in curves if m != "exact"}
     method = "rgb" if "rgb" in curves else "filter"
     h = dict(headline(ratios[method]["mean_de2000"]), method=method, metric="mean_de2000")
+    print(f"  reference's own error: mean CIEDE2000 {ref['noise']['mean_de2000']:.3f} "
+          f"(its halves differ by {ref['noise']['mean_de2000_halves']:.3f}), "
+          f"rel RMSE {ref['noise']['rel_rmse']:.4f}")
     result = {"size": f["crop"][2:], "frame": f, "spectral_variant": spectral,
               "reference": {"spp": reference_spp, "passes": REFERENCE_PASSES,
-                            "seconds": ref["seconds"], "cache": ref["cache"]},
+                            "seconds": ref["seconds"], "cache": ref["cache"],
+                            "noise": ref["noise"]},
               "curves": curves, "equal_error": ratios, "headline": h}
+    if name in CHANNEL_SCENES:
+        result["channel_render"] = dict(channel_render(curves), warnings=said)
     print(f"  headline: {method} reaches mean CIEDE2000 {h['error']:.3f} in {h['seconds']:.2f} s; "
           f"(a) needs {h['exact_seconds_at_error']:.2f} s: ratio {h['ratio']:.3g}"
           + (" (extrapolated)" if h["extrapolated"] else ""))
     plot(name, result, out / f"error_vs_time-{name}.png")
     return result
+
+
+def channel_summary(result: dict) -> dict:
+    """What results.json keeps of a scene's channel-render study: every point of the channel
+    render's and exact sampling's curves (spp, seconds, errors), the ratios at equal error, the
+    reference and its own error."""
+    keep = ("exact", "exact_llvm", *CHANNEL_METHODS)
+    return {"frame": result["frame"], "reference": result["reference"],
+            "curves": {m: result["curves"][m] for m in keep},
+            "at_equal_error": {m: result["channel_render"][m] for m in CHANNEL_METHODS},
+            "warnings": result["channel_render"]["warnings"]}
 
 
 def room(mi, objects: dict) -> dict:
@@ -619,8 +816,11 @@ def main() -> int:
     a = p.parse_args()
     if a.quick:
         global SPP, REFERENCE_SPP, REFERENCE_PASSES, OVERHEAD_SIZE, OVERHEAD_SPP, SCENE_BUDGETS
+        global CHANNEL_METHODS, CHANNEL_RATIO_SPP
         SPP = {"exact": (2, 4, 8), "filter": (2, 4), "rgb": (1, 2)}
         SCENE_BUDGETS = {}
+        CHANNEL_METHODS = {m: (sampler, (1, 4)) for m, (sampler, _) in CHANNEL_METHODS.items()}
+        CHANNEL_RATIO_SPP = (1, 4)
         REFERENCE_SPP, REFERENCE_PASSES, OVERHEAD_SIZE, OVERHEAD_SPP = 64, 4, 16, 2
         a.repeats = 1
     a.out.mkdir(parents=True, exist_ok=True)
@@ -654,9 +854,15 @@ def main() -> int:
             "overhead": summary,
             "analytic_speedup_at_equal_error": {n: r["headline"]["ratio"] for n, r in scenes.items()},
             "equal_error_detail": {n: r["headline"] for n, r in scenes.items()},
+            "reference_noise": {n: dict(r["reference"]["noise"], spp=r["reference"]["spp"])
+                                for n, r in scenes.items()},
+            "channel_render": {n: channel_summary(r) for n, r in scenes.items()
+                               if "channel_render" in r},
             "shortcuts": shortcuts,
             "shortcut_cases": shortcut_cases,
             "settings": {"reference_spp": REFERENCE_SPP, "spp": SPP, "scene_budgets": SCENE_BUDGETS,
+                         "channel_methods": CHANNEL_METHODS, "channel_ratio_spp": CHANNEL_RATIO_SPP,
+                         "jit": {"variant": JIT_VARIANT, "samples_per_pass": JIT_SAMPLES_PER_PASS},
                          "frames": {n: frame(n) for n in scenes}},
             "bench_seconds": time.perf_counter() - started,
         }
