@@ -169,6 +169,22 @@ fn slab_monochromatic_conserves_energy_and_prints_jones_and_mueller() {
     assert_eq!(b["mueller_T"], v["mueller"]["T"]);
 }
 
+/// A slab that the method cannot compute accurately (o and e waves of a weakly birefringent
+/// plate both near grazing under a denser exterior: the computed reflection and transmission of
+/// p light summed to 1.00068, found by the fuzzer) is refused, naming the slab, not returned.
+#[test]
+fn a_slab_that_would_gain_energy_is_refused() {
+    let input = r#"{"beta": 1.0001, "eta_e": 1.0, "eta_o": [1.0001, 1e-300], "ext_ior": 550.0, "optic_axis": [0, 1, 1], "thickness_um": 1.0001, "wavelength_nm": 1.0001}"#;
+    let (code, out) = run(&["slab"], input);
+    assert_ne!(code, 0, "{out}");
+    let v: Value = serde_json::from_str(&out).unwrap();
+    let e = v["error"].as_str().unwrap();
+    assert!(
+        e.starts_with("slab: the computed plate reflects and transmits 1.000"),
+        "{e}"
+    );
+}
+
 #[test]
 fn slab_spectrum_analytic_agrees_with_quadrature() {
     for spectrum in [r#"{"weights": "xyz-d65"}"#, r#"{"bandwidth_nm": 12}"#] {
