@@ -213,6 +213,7 @@ public:
 private:
     /// Input columns of a core query (indices into shim::ChunkBuffers::in).
     enum Column : size_t { AxisX, AxisY, AxisZ, WiX, WiY, WiZ, Sample, ExtIor, Wavelength0 };
+    static_assert(WiY == WiX + 1 && WiZ == WiX + 2 && Sample == WiX + 3, "shim::fill_path_lanes");
 
     /// One core query at normal incidence, at the variant's wavelength (550 nm in the spectral
     /// ones), with the axis as given; throws its message.
@@ -249,8 +250,7 @@ private:
                                             const Mask &active) const {
         shim::require_evaluated_mode<Float>(ClassName);
         shim::HostInputs<Float> in;
-        size_t k_active = in.add_mask(active), k_u = in.add(sample1);
-        size_t k_wi[3] = { in.add(si.wi.x()), in.add(si.wi.y()), in.add(si.wi.z()) };
+        const shim::PathColumns path = shim::add_path_inputs<Float, Spectrum>(in, si, sample1, active);
         size_t k_axis = 0;
         if (m_axis_in_world) {
             Vector3f a = si.to_local(Vector3f(m_optic_axis));
@@ -258,14 +258,8 @@ private:
             in.add(a.y());
             in.add(a.z());
         }
-        size_t k_waves = 0, waves = 1;
-        if constexpr (is_spectral_v<Spectrum>) {
-            waves = Answers::Channels;
-            for (size_t c = 0; c < waves; ++c) {
-                size_t k = in.add(si.wavelengths[c]);
-                k_waves = c == 0 ? k : k_waves;
-            }
-        }
+        // One wavelength column in the RGB and mono variants (m_wavelength).
+        const size_t waves = is_spectral_v<Spectrum> ? path.waves : 1;
         Answers answers;
         size_t n = in.width();
         answers.allocate(n);
@@ -278,20 +272,11 @@ private:
             auto &b = *storage;
             const uint32_t material = 0;
             bfr::CrystalLanes lanes{};
-            lanes.count = end - begin;
-            lanes.active = b.convert_mask(in.masks(k_active), begin, end);
+            shim::fill_path_lanes(lanes, b, in, path, begin, end, WiX, Wavelength0);
             lanes.material = { &material, 1 };
             lanes.transport = { &transport, 1 };
-            lanes.sample = b.convert(Sample, in.floats(k_u), begin, end).slice();
-            lanes.wi = { b.convert(WiX, in.floats(k_wi[0]), begin, end).slice(),
-                         b.convert(WiY, in.floats(k_wi[1]), begin, end).slice(),
-                         b.convert(WiZ, in.floats(k_wi[2]), begin, end).slice() };
-            if constexpr (is_spectral_v<Spectrum>) {
-                for (size_t c = 0; c < waves; ++c)
-                    b.convert(Wavelength0 + c, in.floats(k_waves + c), begin, end);
-            } else {
+            if constexpr (!is_spectral_v<Spectrum>)
                 b.constant(Wavelength0, m_wavelength);
-            }
             lanes.wavelengths_nm = b.wavelength_columns(Wavelength0, waves);
             lanes.ext_ior = b.constant(ExtIor, m_ext_ior).slice();
             if (m_axis_in_world)
@@ -306,7 +291,8 @@ private:
             bfr::Status rc = bfr::sample_crystal(*m_material, components, lanes, s);
             for (size_t j = 0; j < lanes.count; ++j) {
                 size_t i = begin + j;
-                Vec3d wi(in.floats(k_wi[0]).at(i), in.floats(k_wi[1]).at(i), in.floats(k_wi[2]).at(i));
+                Vec3d wi(in.floats(path.wi[0]).at(i), in.floats(path.wi[1]).at(i),
+                         in.floats(path.wi[2]).at(i));
                 answers.write(b, lanes.count, j, waves, wi, radiance, std::nullopt, m_types, i);
             }
             return rc == bfr::Status::Ok ? std::string() : shim::core_message(rc, s.message);

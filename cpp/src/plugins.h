@@ -68,6 +68,49 @@ template <template <typename, typename> class Plugin> void register_plugin(const
         register_refusal(pm, name, v);
 }
 
+/// Host columns (indices into HostInputs) of what every query of both plugins reads: the active
+/// mask, the lobe-choosing sample, `si.wi` and, in the spectral variants, the `waves` sampled
+/// wavelengths from `first_wave` on.
+struct PathColumns {
+    size_t active = 0, sample = 0, wi[3] = { 0, 0, 0 }, first_wave = 0, waves = 0;
+};
+
+/// Queues the inputs of PathColumns on `in`.
+template <typename Float, typename Spectrum, typename Interaction, typename Mask>
+PathColumns add_path_inputs(HostInputs<Float> &in, const Interaction &si, const Float &sample1,
+                            const Mask &active) {
+    PathColumns c;
+    c.active = in.add_mask(active);
+    c.sample = in.add(sample1);
+    for (size_t i = 0; i < 3; ++i)
+        c.wi[i] = in.add(si.wi[i]);
+    if constexpr (is_spectral_v<Spectrum>) {
+        c.waves = Answers<Float, Spectrum>::Channels;
+        for (size_t w = 0; w < c.waves; ++w) {
+            size_t k = in.add(si.wavelengths[w]);
+            c.first_wave = w == 0 ? k : c.first_wave;
+        }
+    }
+    return c;
+}
+
+/// Lanes [begin, end) of PathColumns into `lanes` (a PlateLanes or CrystalLanes): `count`,
+/// `active`, `wi` in input columns `wi_x`, `wi_x + 1`, `wi_x + 2`, `sample` in `wi_x + 3`, and
+/// the sampled wavelengths in columns `wave0`, `wave0 + 1`, ... (the caller sets
+/// `wavelengths_nm`).
+template <typename Lanes, size_t Cap, typename Float>
+void fill_path_lanes(Lanes &lanes, ChunkBuffers<Cap> &b, const HostInputs<Float> &in,
+                     const PathColumns &c, size_t begin, size_t end, size_t wi_x, size_t wave0) {
+    lanes.count = end - begin;
+    lanes.active = b.convert_mask(in.masks(c.active), begin, end);
+    lanes.wi = { b.convert(wi_x, in.floats(c.wi[0]), begin, end).slice(),
+                 b.convert(wi_x + 1, in.floats(c.wi[1]), begin, end).slice(),
+                 b.convert(wi_x + 2, in.floats(c.wi[2]), begin, end).slice() };
+    lanes.sample = b.convert(wi_x + 3, in.floats(c.sample), begin, end).slice();
+    for (size_t w = 0; w < c.waves; ++w)
+        b.convert(wave0 + w, in.floats(c.first_wave + w), begin, end);
+}
+
 /// Defined in thinbirefringent.cpp and birefringent.cpp.
 void register_thinbirefringent();
 void register_birefringent();

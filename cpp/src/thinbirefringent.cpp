@@ -296,6 +296,7 @@ private:
     /// Input columns of a core query (indices into shim::ChunkBuffers::in).
     enum Column : size_t { Thickness, Birefringence, AxisX, AxisY, AxisZ, AxisAngle, WiX, WiY,
                            WiZ, Sample, ExtIor, ExitIor, Wavelength0 };
+    static_assert(WiY == WiX + 1 && WiZ == WiX + 2 && Sample == WiX + 3, "shim::fill_path_lanes");
 
     /// The core's per-call settings.
     bfr::PlateCall call(uint32_t components) const {
@@ -348,19 +349,11 @@ private:
                   const Float &sample1, const Mask &active, bool straight) const {
         shim::require_evaluated_mode<Float>(ClassName);
         shim::HostInputs<Float> in;
-        size_t k_active = in.add_mask(active), k_u = in.add(sample1);
-        size_t k_wi[3] = { in.add(si.wi.x()), in.add(si.wi.y()), in.add(si.wi.z()) };
+        const shim::PathColumns path = shim::add_path_inputs<Float, Spectrum>(in, si, sample1, active);
         size_t k_thick = in.add(m_thickness->eval_1(si, active));
         size_t k_biref = m_birefringence ? in.add(m_birefringence->eval_1(si, active)) : 0;
         size_t k_angle = m_axis_angle ? in.add(m_axis_angle->eval_1(si, active)) : 0;
-        size_t k_waves = 0, waves = 0;
-        if constexpr (is_spectral_v<Spectrum>) {
-            waves = Answers::Channels;
-            for (size_t c = 0; c < waves; ++c) {
-                size_t k = in.add(si.wavelengths[c]);
-                k_waves = c == 0 ? k : k_waves;
-            }
-        }
+        const size_t waves = path.waves;
         Answers answers;
         size_t n = in.width();
         answers.allocate(n);
@@ -376,16 +369,9 @@ private:
             auto &b = *storage;
             const uint32_t material = 0;
             bfr::PlateLanes lanes{};
-            lanes.count = end - begin;
-            lanes.active = b.convert_mask(in.masks(k_active), begin, end);
+            shim::fill_path_lanes(lanes, b, in, path, begin, end, WiX, Wavelength0);
             lanes.material = { &material, 1 };
             lanes.transport = { &transport, 1 };
-            lanes.sample = b.convert(Sample, in.floats(k_u), begin, end).slice();
-            lanes.wi = { b.convert(WiX, in.floats(k_wi[0]), begin, end).slice(),
-                         b.convert(WiY, in.floats(k_wi[1]), begin, end).slice(),
-                         b.convert(WiZ, in.floats(k_wi[2]), begin, end).slice() };
-            for (size_t c = 0; c < waves; ++c)
-                b.convert(Wavelength0 + c, in.floats(k_waves + c), begin, end);
             lanes.wavelengths_nm = b.wavelength_columns(Wavelength0, waves);
             lanes.ext_ior = b.constant(ExtIor, m_ext_ior).slice();
             lanes.exit_ior = b.constant(ExitIor, m_exit_ior).slice();
@@ -404,7 +390,8 @@ private:
             bfr::Status rc = bfr::sample_plate(*m_material, *m_spectrum, settings, lanes, s);
             for (size_t j = 0; j < lanes.count; ++j) {
                 size_t i = begin + j;
-                Vec3d wi(in.floats(k_wi[0]).at(i), in.floats(k_wi[1]).at(i), in.floats(k_wi[2]).at(i));
+                Vec3d wi(in.floats(path.wi[0]).at(i), in.floats(path.wi[1]).at(i),
+                         in.floats(path.wi[2]).at(i));
                 std::optional<Vec3d> through;
                 if (straight)
                     through = -wi;
