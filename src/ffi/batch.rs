@@ -42,16 +42,14 @@ pub fn sample_plate(
         spectrum.check_wavelength_columns(cols.common.wavelengths.count())?;
         let channels = spectrum.channels(cols.common.wavelengths.count());
         let mut output = Output::new(out, lanes.count, channels)?;
-        for i in 0..lanes.count {
-            let lane = || plate_lane(materials, spectrum, call, &cols, i);
-            write_lane(
-                &mut output,
-                i,
-                cols.common.active.at(i),
-                lane,
-                plate_component,
-            );
-        }
+        let lane = |i| plate_lane(materials, spectrum, call, &cols, i);
+        write_lanes(
+            &mut output,
+            lanes.count,
+            &cols.common.active,
+            lane,
+            plate_component,
+        );
         Ok(output.status())
     };
     finish(guarded(run), out)
@@ -74,16 +72,14 @@ pub fn sample_crystal(
             ));
         }
         let mut output = Output::new(out, lanes.count, channels)?;
-        for i in 0..lanes.count {
-            let lane = || crystal_lane(materials, components, &cols, i);
-            write_lane(
-                &mut output,
-                i,
-                cols.common.active.at(i),
-                lane,
-                crystal_component,
-            );
-        }
+        let lane = |i| crystal_lane(materials, components, &cols, i);
+        write_lanes(
+            &mut output,
+            lanes.count,
+            &cols.common.active,
+            lane,
+            crystal_component,
+        );
         Ok(output.status())
     };
     finish(guarded(run), out)
@@ -95,6 +91,19 @@ fn finish(r: Result<Status>, out: &mut Samples) -> Status {
         out.message = e.to_string();
         status(&e)
     })
+}
+
+/// Computes each of the call's `count` lanes (`lane(i)`, skipping inactive ones) and writes it.
+fn write_lanes<const S: usize>(
+    output: &mut Output,
+    count: usize,
+    active: &Column<u8>,
+    lane: impl Fn(usize) -> Result<Sampled<S>>,
+    component: fn(usize) -> usize,
+) {
+    for i in 0..count {
+        write_lane(output, i, active.at(i), || lane(i), component);
+    }
 }
 
 /// Computes lane `i` (unless inactive) and writes it.
