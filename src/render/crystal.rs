@@ -193,9 +193,10 @@ fn each_lobe(
                         component,
                         l.direction,
                         (l.stokes_x, event.incident_stokes_x),
-                        reversed(&l.mueller) * (event.incident_ray_index / l.ray_index).powi(2),
+                        reversed(&l.mueller),
                         l.ray_index / event.incident_ray_index,
-                    ),
+                    )
+                    .with_radiance_factor((event.incident_ray_index / l.ray_index).powi(2)),
                 ),
             }
         }
