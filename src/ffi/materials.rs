@@ -62,6 +62,11 @@ impl Materials {
             .map_or_else(String::new, |(_, w)| w.clone())
     }
 
+    /// Every material of the table.
+    pub fn all(&self) -> impl Iterator<Item = &Material> {
+        self.0.iter().map(|(m, _)| m)
+    }
+
     /// Material `index`.
     pub fn get(&self, index: u32) -> Result<&Material> {
         self.0.get(index as usize).map(|(m, _)| m).ok_or_else(|| {

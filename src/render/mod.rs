@@ -12,8 +12,10 @@
 pub mod choice;
 pub mod crystal;
 pub mod isotropic;
+pub mod mitsuba_frames;
 pub mod plate;
 pub mod slots;
+pub mod tangents;
 
 use nalgebra::{Matrix4, Vector3};
 
