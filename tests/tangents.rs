@@ -6,6 +6,14 @@
 //! extrapolation over random plates and crystal surfaces (the bound stated in
 //! docs/gradients.md).
 
+use birefringent::ffi::bridge::{
+    CrystalLanes, PlateCall, PlateLanes, Samples, Status, Tangent, Tangents, Transport as T,
+};
+use birefringent::ffi::{
+    band_spectrum, colour_channel_spectrum, crystal_tangents_available, exact_spectrum,
+    new_materials, plate_tangents_available, sample_crystal, sample_crystal_tangents, sample_plate,
+    sample_plate_tangents, srgb_spectrum, Materials, PlateSpectrum,
+};
 use birefringent::material::Material;
 use birefringent::optics::medium::Uniaxial;
 use birefringent::optics::surface::Surface;
@@ -525,4 +533,238 @@ fn lane_errors<const S: usize>(
         k += input.columns();
     }
     Some(out)
+}
+
+// ---- the bridge (`sample_plate_tangents`, `sample_crystal_tangents`) -----------------------
+
+/// Owned output columns (intensity only: `value[0]`) and derivative columns.
+struct Owned {
+    status: Vec<Status>,
+    component: Vec<u32>,
+    pdf: Vec<f64>,
+    eta: Vec<f64>,
+    wo: [Vec<f64>; 3],
+    value: Vec<f64>,
+    d_wo: [Vec<f64>; 3],
+    d_value: Vec<f64>,
+}
+
+impl Owned {
+    fn new(n: usize, channels: usize, columns: usize) -> Self {
+        Owned {
+            status: vec![Status::Internal; n],
+            component: vec![0; n],
+            pdf: vec![f64::NAN; n],
+            eta: vec![f64::NAN; n],
+            wo: std::array::from_fn(|_| vec![f64::NAN; n]),
+            value: vec![f64::NAN; n * channels],
+            d_wo: std::array::from_fn(|_| vec![f64::NAN; n * columns]),
+            d_value: vec![f64::NAN; n * channels * columns],
+        }
+    }
+
+    fn views<'a>(&'a mut self, inputs: &'a [Tangent]) -> (Samples<'a>, Tangents<'a>) {
+        let [a, b, c] = &mut self.wo;
+        let [d, e, f] = &mut self.d_wo;
+        let mut value = [&mut self.value[..]].into_iter();
+        let mut d_value = [&mut self.d_value[..]].into_iter();
+        let samples = Samples {
+            status: &mut self.status,
+            component: &mut self.component,
+            pdf: &mut self.pdf,
+            eta: &mut self.eta,
+            wo: [a, b, c],
+            in_stokes_x: [&mut [], &mut [], &mut []],
+            out_stokes_x: [&mut [], &mut [], &mut []],
+            value: std::array::from_fn(|_| value.next().unwrap_or_default()),
+            message: String::new(),
+        };
+        let tangents = Tangents {
+            inputs,
+            wo: [d, e, f],
+            value: std::array::from_fn(|_| d_value.next().unwrap_or_default()),
+        };
+        (samples, tangents)
+    }
+}
+
+/// A plate batch of 6 lanes (one inactive) at thickness `t` nm: (status, owned outputs).
+fn plate_batch(
+    m: &Materials,
+    spectrum: &PlateSpectrum,
+    t: f64,
+    inputs: &[Tangent],
+) -> (Status, Owned) {
+    let n = 6;
+    let wis: Vec<Vector3<f64>> = (0..n)
+        .map(|i| {
+            Vector3::new(
+                0.1 * i as f64,
+                -0.05 * i as f64,
+                if i % 2 == 0 { 1.0 } else { -1.0 },
+            )
+            .normalize()
+        })
+        .collect();
+    let col = |k: usize| -> Vec<f64> { wis.iter().map(|w| w[k]).collect() };
+    let (wx, wy, wz) = (col(0), col(1), col(2));
+    let waves = [vec![450.0; 1], vec![560.0; 1], vec![630.0; 1]];
+    let wave_refs: Vec<&[f64]> = waves.iter().map(|w| w.as_slice()).collect();
+    let active: Vec<u8> = (0..n).map(|i| u8::from(i != 3)).collect();
+    let sample: Vec<f64> = (0..n).map(|i| (i as f64 + 0.5) / n as f64).collect();
+    let lanes = PlateLanes {
+        count: n,
+        active: &active,
+        material: &[0],
+        transport: &[T::Radiance],
+        sample: &sample,
+        wi: [&wx, &wy, &wz],
+        wavelengths_nm: &wave_refs,
+        ext_ior: &[1.0],
+        exit_ior: &[1.3],
+        optic_axis: [&[1.0], &[0.3], &[0.2]],
+        axis_angle_deg: &[15.0],
+        thickness_nm: &[t],
+        birefringence: &[0.001],
+    };
+    let call = PlateCall {
+        components: 3,
+        intensity_only: true,
+        absorbing_exit: false,
+    };
+    let columns: usize = inputs
+        .iter()
+        .map(|t| {
+            if matches!(*t, Tangent::Wi | Tangent::OpticAxis) {
+                3
+            } else {
+                1
+            }
+        })
+        .sum();
+    let mut o = Owned::new(n, 3, columns);
+    let rc = {
+        let (mut s, mut d) = o.views(inputs);
+        if inputs.is_empty() {
+            sample_plate(m, spectrum, &call, &lanes, &mut s)
+        } else {
+            sample_plate_tangents(m, spectrum, &call, &lanes, &mut d, &mut s)
+        }
+    };
+    (rc, o)
+}
+
+/// The derivative columns through the bridge: the samples are the plain call's, bit for bit;
+/// column k of lane i sits at `k * count + i` (channel c of the weight at
+/// `(k * channels + c) * count + i`); an inactive lane has zero derivatives; the thickness
+/// column equals central differences of the bridge's own lobes (`value * pdf`, intensity only)
+/// over thickness (1e-6).
+#[test]
+fn bridge_columns_are_the_lanes_derivatives() {
+    let mut m = new_materials();
+    m.add_constant(1.54, 1.55, 0.0, 0.0).unwrap();
+    let spectrum = exact_spectrum();
+    let inputs = [Tangent::Wi, Tangent::Thickness];
+    let (rc, plain) = plate_batch(&m, &spectrum, 2000.0, &[]);
+    let (rc_t, with) = plate_batch(&m, &spectrum, 2000.0, &inputs);
+    assert_eq!((rc, rc_t), (Status::Ok, Status::Ok));
+    assert_eq!(plain.pdf, with.pdf);
+    assert_eq!(plain.value, with.value);
+    assert_eq!(plain.wo, with.wo);
+    let (n, channels, h) = (6, 3, 1e-3);
+    let (_, plus) = plate_batch(&m, &spectrum, 2000.0 + h, &[]);
+    let (_, minus) = plate_batch(&m, &spectrum, 2000.0 - h, &[]);
+    for i in 0..n {
+        for c in 0..channels {
+            let d = with.d_value[(3 * channels + c) * n + i]; // column 3: the thickness
+            if i == 3 {
+                assert_eq!(d, 0.0, "inactive lane");
+                continue;
+            }
+            assert_eq!(plus.component[i], with.component[i]);
+            let lobe = |o: &Owned| o.value[c * n + i] * o.pdf[i];
+            let fd = (lobe(&plus) - lobe(&minus)) / (2.0 * h);
+            let exact = d * with.pdf[i];
+            assert!(
+                (exact - fd).abs() <= 1e-6 * fd.abs().max(1e-6),
+                "lane {i} channel {c}: {exact} vs {fd}"
+            );
+        }
+    }
+}
+
+/// A query that cannot give derivatives says why, naming what to change, and writes nothing
+/// else: the plate over a band, the sRGB channels or a colour channel; `eta_o` of a named
+/// crystal; a plate's input of a crystal; `kappa` of a birefringent crystal; an input asked
+/// twice; derivative columns of the wrong length.
+#[test]
+fn requests_without_derivatives_are_refused_with_the_reason() {
+    let mut m = new_materials();
+    m.add_constant(1.54, 1.55, 0.0, 0.0).unwrap();
+    let mut named = new_materials();
+    named.add_named("calcite", 0.0, 0.0).unwrap();
+    let none: &[Tangent] = &[Tangent::Thickness];
+    let err = |r: birefringent::Result<()>| r.unwrap_err().to_string();
+    assert!(plate_tangents_available(&m, &exact_spectrum(), none).is_ok());
+    let e = err(plate_tangents_available(&m, &band_spectrum(4.0), none));
+    assert!(
+        e.contains("filter_bandwidth") && e.contains("llvm_ad_spectral"),
+        "{e}"
+    );
+    let e = err(plate_tangents_available(&m, &srgb_spectrum(), none));
+    assert!(
+        e.contains("llvm_ad_rgb") && e.contains("llvm_ad_spectral_polarized"),
+        "{e}"
+    );
+    let channel = colour_channel_spectrum("srgb-d65:G").unwrap();
+    let e = err(plate_tangents_available(&m, &channel, none));
+    assert!(
+        e.contains("llvm_ad_mono") && e.contains("srgb-d65:G"),
+        "{e}"
+    );
+    let e = err(plate_tangents_available(
+        &named,
+        &exact_spectrum(),
+        &[Tangent::EtaO],
+    ));
+    assert!(e.starts_with("eta_o"), "{e}");
+    assert!(plate_tangents_available(&named, &exact_spectrum(), &[Tangent::KappaE]).is_ok());
+    let e = err(crystal_tangents_available(&m, &[Tangent::AxisAngle]));
+    assert!(e.starts_with("axis_angle") && e.contains("plate"), "{e}");
+    let e = err(crystal_tangents_available(&m, &[Tangent::KappaO]));
+    assert!(
+        e.starts_with("kappa_o") && e.contains("birefringent"),
+        "{e}"
+    );
+    let mut glass = new_materials();
+    glass.add_constant(1.5, 1.5, 0.1, 0.1).unwrap();
+    assert!(crystal_tangents_available(&glass, &[Tangent::KappaO, Tangent::EtaE]).is_ok());
+    let e = err(crystal_tangents_available(&m, &[Tangent::Wi, Tangent::Wi]));
+    assert!(e.contains("twice"), "{e}");
+    // Columns of the wrong length: the call fails as a whole, with the column's name.
+    let (rc, _) = plate_batch(&m, &band_spectrum(4.0), 2000.0, none);
+    assert_eq!(rc, Status::Invalid);
+    let mut o = Owned::new(1, 1, 1);
+    o.d_value.push(0.0);
+    let inputs = [Tangent::EtaO];
+    let (mut s, mut d) = o.views(&inputs);
+    let lanes = CrystalLanes {
+        count: 1,
+        active: &[1],
+        material: &[0],
+        transport: &[T::Radiance],
+        sample: &[0.5],
+        wi: [&[0.0], &[0.0], &[1.0]],
+        wavelengths_nm: &[&[550.0]],
+        ext_ior: &[1.0],
+        optic_axis: [&[1.0], &[0.0], &[0.0]],
+    };
+    assert_eq!(
+        sample_crystal_tangents(&m, 7, &lanes, &mut d, &mut s),
+        Status::Invalid
+    );
+    assert!(s.message.contains("tangents.value"), "{}", s.message);
+    let mut o = Owned::new(1, 1, 0);
+    let (mut s, _) = o.views(&[]);
+    assert_eq!(sample_crystal(&m, 7, &lanes, &mut s), Status::Ok);
 }
