@@ -23,7 +23,7 @@ Bulk birefringent crystal (:monosp:`birefringent`)
    - Constant ordinary / extraordinary indices instead of ``material`` (give both; not together
      with ``material``), within [1e-3, 1e3] (as is every index). Spectra are not supported
      yet. Exposed only when given.
-   - |exposed|
+   - |exposed|, |differentiable|
 
  * - kappa_o, kappa_e
    - |float|
@@ -34,13 +34,13 @@ Bulk birefringent crystal (:monosp:`birefringent`)
      :monosp:`thinbirefringent` for a dichroic plate). An absorbing bulk is opaque, like
      :monosp:`conductor`: what refracts into it is absorbed at the surface, so there is the
      reflection alone from outside and nothing from inside. (Default: 0)
-   - |exposed|
+   - |exposed|, |differentiable|
 
  * - optic_axis
    - |vector|
    - The optic axis, any non-zero length, in the frame that ``optic_axis_space`` names.
      (Default: ``[1, 0, 0]``)
-   - |exposed|
+   - |exposed|, |differentiable|
 
  * - optic_axis_space
    - |string|

@@ -23,19 +23,19 @@ Birefringent plate (:monosp:`thinbirefringent`)
    - Constant ordinary / extraordinary indices instead of ``material`` (give both; not together
      with ``material``), within [1e-3, 1e3] (as is every index). Spectra are not supported
      yet. Exposed only when given.
-   - |exposed|
+   - |exposed|, |differentiable|
 
  * - kappa_o, kappa_e
    - |float|
    - Extinction coefficients added to the indices (``n + i kappa``, ``0 <= kappa <= 1e3``;
      dichroism when they differ). (Default: 0)
-   - |exposed|
+   - |exposed|, |differentiable|
 
  * - optic_axis
    - |vector|
    - The optic axis in the local shading frame (x = dp/du, z = normal), any non-zero length; at
      each point rotated about the normal by ``axis_angle``. (Default: ``[1, 0, 0]``)
-   - |exposed|
+   - |exposed|, |differentiable|
 
  * - ext_ior
    - |float| or |string|
@@ -52,7 +52,7 @@ Birefringent plate (:monosp:`thinbirefringent`)
    - |float| or |texture|
    - Thickness in micrometres (times ``thickness_scale``), within [0, 1e6] (1 m); where a texture
      gives a value outside, that point returns no light (one warning). (Default: 1)
-   - |exposed|
+   - |exposed|, |differentiable|
 
  * - thickness_scale
    - |float|
@@ -63,7 +63,7 @@ Birefringent plate (:monosp:`thinbirefringent`)
    - |float| or |texture|
    - Added to Re ``eta_e`` (times ``birefringence_scale``): the stress-induced birefringence
      ``C (sigma_1 - sigma_2)`` of a photoelastic plate. Exposed only when given. (Default: none)
-   - |exposed|
+   - |exposed|, |differentiable|
 
  * - birefringence_scale
    - |float|
@@ -75,14 +75,16 @@ Birefringent plate (:monosp:`thinbirefringent`)
    - Degrees; rotates ``optic_axis`` about the normal, counter-clockwise seen from the exterior
      (from x towards y): the principal stress direction of a photoelastic plate. Exposed only
      when given. (Default: 0)
-   - |exposed|
+   - |exposed|, |differentiable|
 
  * - filter_bandwidth
    - |float|
    - Spectral variants: full width at half maximum (nm) of the Gaussian band around each sampled
      wavelength over which the plate is integrated in closed form; 0 (or below 1e-12 of the
      wavelength) is the exact plate at the wavelength (the default: a band never paid at equal
-     error in the scene benchmark); at most a quarter of the wavelength. (Default: 0)
+     error in the scene benchmark); at most a quarter of the wavelength. Gradients (llvm_ad
+     variants) need 0: the band's closed form has no derivatives yet (docs/gradients.md).
+     (Default: 0)
    - |exposed|
 
  * - channel
