@@ -81,7 +81,10 @@ def scene_dict(size: int, dsigma: np.ndarray, angle: np.ndarray,
             "axis_angle": data_texture(angle)}
     d = {
         "type": "scene",
-        "integrator": {"type": "stokes", "integrator": {"type": "path", "max_depth": 8}},
+        # Russian roulette off: its survival probability follows the throughput, which would
+        # make the loss jump with the fitted parameters.
+        "integrator": {"type": "stokes",
+                       "integrator": {"type": "path", "max_depth": 8, "rr_depth": 100}},
         "light": backlight(-3.0, 4.0),
         "polarizer": layer(-2.0, 2, 2, {"type": "polarizer", "theta": 0.0}),
         "qwp_in": layer(-1.5, 2, 2, {"type": "retarder", "theta": 45.0, "delta": 90.0}),
@@ -202,7 +205,9 @@ def figure(result: dict, path: pathlib.Path) -> pathlib.Path:
          f"recovered (RMS {result['direction_rms_deg']:.2f} deg)", "twilight", (-90, 90)),
     ]
     for a, img, title, cmap, lim in panels:
-        im = a.imshow(img, origin="lower", extent=extent, cmap=cmap,
+        # Texture row 0 is the bottom of the disk (y = -1); image row 0 is the top.
+        origin = "upper" if img is result["target_crossed"] else "lower"
+        im = a.imshow(img, origin=origin, extent=extent, cmap=cmap,
                       vmin=None if lim is None else lim[0], vmax=None if lim is None else lim[1])
         a.set_title(title, fontsize=9)
         a.set_xticks([])

@@ -52,6 +52,8 @@ public:
                 o.allocate(n);
         m_tangents = std::move(tangents);
         size_t columns = m_tangents.columns();
+        if (columns == 0)
+            return;  // the plain query: nothing more
         m_d_wo.resize(3 * columns);
         m_d_value.resize(Entries * Channels * columns);
         for (auto &o : m_d_wo)
@@ -157,9 +159,9 @@ private:
 
     /// `value` with the derivative columns `column(k)` attached to the query's inputs, except
     /// columns that are zero in every lane (`used[k]` false), which are left out: an input that
-    /// does not move a quantity (the thickness does not move `wo`) adds no term to the graph.
-    /// (Leaving them in would also attach e.g. `wo` where Mitsuba's frame rotations at exactly
-    /// normal incidence differentiate `sqrt` at 0: a gradient of 0 times infinity, NaN.)
+    /// does not move a quantity (the thickness does not move `wo`) adds no term to the graph,
+    /// and the quantity stays detached for the integrator (e.g. its frame rotations at exactly
+    /// normal incidence, where Mitsuba's `unit_angle` differentiates `sqrt` at 0).
     template <typename Column>
     Float attached(const Float &value, Column &&column, const Flags &used) const {
         if (m_tangents.empty())

@@ -141,6 +141,49 @@ def test_render_gradient(case):
     check_render(*render_derivatives(reflection_scene(bsdf), keys, direction, h))
 
 
+def polariscope_scene(stress: float) -> dict:
+    """The photoelastic disk's set-up at normal incidence (an orthographic camera straight down
+    the optical axis, where every Stokes frame of the path coincides): a circular polariser, an
+    immersed stressed plate (ext_ior = exit_ior = its index: no reflection, one lobe), a crossed
+    circular analyser."""
+    from _common import backlight, layer, ortho_sensor
+
+    plate = {"type": "thinbirefringent", "eta_o": 1.585, "eta_e": 1.585, "ext_ior": 1.585,
+             "exit_ior": 1.585, "thickness": 6000.0, "birefringence": stress,
+             "birefringence_scale": 8e-5, "axis_angle": 30.0}
+    # Russian roulette off (rr_depth beyond the path): its survival probability follows the
+    # throughput, which makes the estimate flat in it (a finite difference then sees ~0).
+    return {"type": "scene", "integrator": {"type": "volpath", "max_depth": 8, "rr_depth": 100},
+            "sensor": ortho_sensor(6, 6, 2, 1.0, 1.0),
+            "light": backlight(-3.0, 4.0),
+            "polarizer": layer(-2.0, 2, 2, {"type": "polarizer", "theta": 0.0}),
+            "qwp_in": layer(-1.5, 2, 2, {"type": "retarder", "theta": 45.0, "delta": 90.0}),
+            "plate": layer(0.0, 2, 2, plate),
+            "qwp_out": layer(1.5, 2, 2, {"type": "retarder", "theta": -45.0, "delta": 90.0}),
+            "analyser": layer(2.0, 2, 2, {"type": "polarizer", "theta": 90.0})}
+
+
+@pytest.mark.parametrize("key,h", [("plate.bsdf.birefringence.value", H[8]),
+                                   ("plate.bsdf.axis_angle.value", 0.5)])
+def test_polariscope_at_normal_incidence(key, h):
+    """The disk's own geometry: gradients finite (no NaN from the frame rotations at exactly
+    normal incidence, where a sampled direction attached to the graph would differentiate
+    sqrt at 0: columns that are zero in every lane are not attached) and equal to the finite
+    differences. Under crossed circular polarisers the image is (1/2) sin^2(delta / 2), blind
+    to the axis: its derivative must vanish."""
+    import sys
+    import pathlib
+
+    sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "scenes"))
+    mi.set_variant(POLARIZED)
+    forward, fd, reverse, reverse_fd = render_derivatives(polariscope_scene(0.4), key, 1.0, h)
+    assert np.all(np.isfinite(forward)) and np.isfinite(reverse)
+    if "axis_angle" in key:
+        assert np.abs(forward).max() < 1e-6 and abs(reverse) < 1e-5 and np.abs(fd).max() < 1e-4
+        return
+    check_render(forward, fd, reverse, reverse_fd)
+
+
 CRYSTAL = {"type": "birefringent", "eta_o": 1.55, "eta_e": 1.65, "optic_axis": [0.3, 0.5, 0.8]}
 
 
