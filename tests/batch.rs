@@ -3,9 +3,10 @@
 //! same order: `PlateQuery` + `plate_lobes`, or `crystal_slots` per wavelength, then the choice
 //! of a lobe, here written out from its documentation rather than by calling `choose`), over
 //! random batches that mix materials, sides, transport modes, directions, wavelengths, geometry,
-//! failing lanes and every channel of every weight set; one-lane batches (what the scalar variants send) equal the big
-//! batch; a single-value column equals the same value repeated (broadcast); columns of the
-//! wrong length are refused with a message naming them.
+//! failing lanes and every channel of every weight set; one-lane batches (what the scalar
+//! variants send) equal the big batch; the choice is an unbiased sampler of every channel; a
+//! single-value column equals the same value repeated (broadcast); columns of the wrong length
+//! are refused with a message naming them.
 
 use birefringent::ffi::bridge::{
     CrystalLanes, PlateCall, PlateLanes, Samples, Status, Transport as T,
@@ -605,7 +606,7 @@ fn plate_batches_equal_scalar_queries_bit_for_bit() {
 /// slots' probabilities sum to 1, and Σ pdf · value over the slots is each channel's sum of its
 /// lobes (`plate_lobes` directly), entry by entry, to 1e-12 relative: every channel's
 /// expectation holds. Among the lanes: a lithium niobate film on silica whose reflection is
-/// negative in sRGB R (out of gamut), which a choice by signed weights would never pick.
+/// negative in sRGB R (out of gamut): its expectation holds with a negative channel too.
 #[test]
 fn the_choice_is_an_unbiased_sampler_of_every_channel() {
     const K: usize = 1000;
