@@ -25,7 +25,8 @@ before a Python-only mutation that follows. A restored file is written anew (a f
 modification time), so that cargo rebuilds it; a mutation that does not build is an error, not a
 kill.
 
-Standard library only. Usage: tools/mutants.py [--only ID[,ID...]] [--list] [--baseline]
+Standard library only. Usage: tools/mutants.py [--only ID[,ID...]] [--baseline] [--show]
+[--list FILE] [--scratch DIR] [--timeout SECONDS]; logs in <scratch>/logs/<id>.log.
 """
 
 from __future__ import annotations
@@ -181,6 +182,7 @@ class Scratch:
         self.env = env
         self.dirty = False  # the package holds a mutated library
         self.clean_digest = ""  # the unmutated library's
+        self.offset = 0  # where the last command's output starts in its log
 
     def command(self, argv: list[str]) -> list[str]:
         """`argv` with `pytest` and `cargo` resolved."""
@@ -324,7 +326,7 @@ def report(mutants: list[Mutant], wall: float) -> bool:
     print(f"\n{'mutation':<{width}}  {'result':<16} {'time':>7}  killed by / note")
     for m in mutants:
         print(f"{m.id:<{width}}  {m.result:<16} {m.seconds:6.0f}s  {m.by}")
-    bad = [m for m in mutants if m.result != "killed" and not m.result.startswith("killed")]
+    bad = [m for m in mutants if not m.result.startswith("killed")]
     for m in bad:
         print(f"\n{m.id} ({m.file}): {m.result}; {m.why}")
         for line in m.log:
