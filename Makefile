@@ -29,6 +29,10 @@
 #   make fuzz-ci  (part of test) the same, strict (FUZZ_STRICT=1: soft findings fail), for
 #                 FUZZ_CI_SECONDS per libFuzzer target (10) and PLUGIN_FUZZ_CI_SECONDS (20)
 #                 for the plugin fuzzer
+#   make mutants  (not part of test) mutation testing: each mutation of tests/mutants/mutants.toml
+#                 applied alone to a scratch copy in target/mutants/, rebuilt, and the tests that
+#                 claim to cover it run; prints which are killed and which survive, fails if one
+#                 survives or no longer applies (tools/mutants.py; MUTANTS=id,id runs only those)
 #   make bench    make setup, then the core benchmark on one core (taskset -c 0) and its plot:
 #                 bench/out/core.json, bench/out/core_error_vs_time.png (several minutes), then
 #                 make bench-scenes and make bench-jit
@@ -71,7 +75,7 @@ PLUGIN_BUILT := target/release/libmitsuba_birefringent.so
 # site-packages of .venv/ (evaluated when used: the venv may not exist yet when make starts)
 SITE = $(shell $(VPY) -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')
 
-.PHONY: help setup build venv llvm plugin plugin-lib render gallery test test-rust test-python fuzz fuzz-ci bench bench-scenes bench-overhead bench-jit fmt lint clean distclean
+.PHONY: help setup build venv llvm plugin plugin-lib render gallery test test-rust test-python mutants fuzz fuzz-ci bench bench-scenes bench-overhead bench-jit fmt lint clean distclean
 
 help:
 	@sed -n '3,/^$$/s/^# \{0,1\}//p' $(firstword $(MAKEFILE_LIST))
@@ -183,6 +187,15 @@ test-python: plugin
 	  echo "$(PYTESTS): no Python test files; nothing to run"; rc=0; \
 	fi; \
 	exit $$rc
+
+## ---- mutation testing ------------------------------------------------------------------
+
+# tools/mutants.py: the copy in target/mutants/ builds with its own target dir (incremental
+# between mutations and runs) and the wheels of .venv/ (SITE); its tests run with .venv/'s
+# interpreter and the copy's package and plugin library (not the editable install's).
+MUTANTS ?=
+mutants: venv llvm
+	$(VPY) tools/mutants.py $(if $(MUTANTS),--only $(MUTANTS))
 
 ## ---- fuzzing --------------------------------------------------------------------------
 
