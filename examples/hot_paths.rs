@@ -17,7 +17,11 @@
 //! the 3 mm photoelastic plate of the overhead benchmark, `plate_quartz0_rgb`,
 //! `plate_quartz5_rgb`, `plate_quartz150_rgb`, `plate_stress_rgb`). Directions: 64 on a spiral up
 //! to `THETA_MAX` degrees from the normal (default 45, the directions plugin/README.md's counts
-//! are quoted for).
+//! are quoted for). `angle:<material>:<thickness_nm>:<theta_deg>`: the sRGB query of a render
+//! (`plate_lobes`, both lobes, full Mueller, Radiance) through a plate of a named crystal (axis
+//! `(1, 1, 0)`) from one direction at `theta_deg` (azimuth 30 degrees), e.g.
+//! `angle:quartz:5000:80`: the cases of the spectral integral's profile (issue 20: 0, 45, 80
+//! and 89 degrees; 0, 5 and 150 um).
 
 use birefringent::material::Material;
 use birefringent::optics::interface::Interface;
@@ -61,6 +65,32 @@ fn main() {
     let n: usize = a[2].parse().unwrap();
     let ds = dirs(64);
     let c = |x: f64| C64::new(x, 0.0);
+    if let Some(spec) = case.strip_prefix("angle:") {
+        let parts: Vec<&str> = spec.split(':').collect();
+        let [material, thickness, theta] = parts[..] else {
+            panic!("angle:<material>:<thickness_nm>:<theta_deg>")
+        };
+        let (th, theta): (f64, f64) = (thickness.parse().unwrap(), theta.parse().unwrap());
+        let q = PlateQuery::new(
+            Material::named(material, 0.0, 0.0).unwrap(),
+            0.0,
+            c(1.0),
+            c(1.0),
+            Vector3::new(1.0, 1.0, 0.0),
+            Thickness::from_nm(th).unwrap(),
+            true,
+            true,
+            false,
+        )
+        .unwrap();
+        let (t, p) = (theta.to_radians(), 30f64.to_radians());
+        let wi = Vector3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos());
+        let spectrum = Spectrum::Weights(WeightSet::SrgbD65);
+        for _ in 0..n {
+            black_box(plate_lobes(&q, &spectrum, black_box(wi), Transport::Radiance).unwrap());
+        }
+        return;
+    }
     match case {
         "interface" => {
             let air = Uniaxial::isotropic(c(1.0)).unwrap();

@@ -174,6 +174,7 @@ impl ClassAmplitudes {
             self.transmission[..Lobe::Transmission.classes(order)].fill(zero);
         }
         let ft = C64::new(b.flux.sqrt(), 0.0);
+        let one = C64::new(1.0, 0.0);
         let z = [C64::new(0.0, 0.0); 2];
         // Stage Dₙ (n + 1 traversals down, i of them e; n up, j of them e): cell
         // (i (n + 1) + j) 2 + m.
@@ -181,53 +182,54 @@ impl ClassAmplitudes {
         self.down[0] = [b.t1[(0, 0)], b.t1[(0, 1)]];
         self.down[2 + 1] = [b.t1[(1, 0)], b.t1[(1, 1)]];
         for n in 0..=order {
-            let (rows, cols) = (n + 2, n + 1);
-            if want.transmission {
-                for (cell, v) in self.down[..2 * rows * cols].iter().enumerate() {
-                    let (ij, m) = (cell / 2, cell % 2);
-                    let a =
-                        &mut self.transmission[Lobe::Transmission.index(n, ij / cols, ij % cols)];
-                    add_outer(a, &b.t2, m, v, ft);
-                }
-            }
-            // Uₙ: the waves after the bottom reflection (n + 1 up, j of them e).
-            let up_cols = n + 2;
+            let (rows, cols, up_cols) = (n + 2, n + 1, n + 2);
+            let (t_base, r_base) = (
+                Lobe::Transmission.index(n, 0, 0),
+                Lobe::Reflection.index(n, 0, 0),
+            );
             self.up[..2 * rows * up_cols].fill(z);
-            for (cell, v) in self.down[..2 * rows * cols].iter().enumerate() {
-                if v[0].norm_sqr() + v[1].norm_sqr() < NEGLIGIBLE {
-                    continue;
-                }
-                let (ij, m) = (cell / 2, cell % 2);
-                let (i, j) = (ij / cols, ij % cols);
-                for to in 0..2 {
-                    let r = b.r2[(to, m)];
-                    let u = &mut self.up[2 * (i * up_cols + j + to) + to];
-                    u[0] += r * v[0];
-                    u[1] += r * v[1];
-                }
-            }
-            if want.reflection {
-                for (cell, v) in self.up[..2 * rows * up_cols].iter().enumerate() {
-                    let (ij, m) = (cell / 2, cell % 2);
-                    let a =
-                        &mut self.reflection[Lobe::Reflection.index(n, ij / up_cols, ij % up_cols)];
-                    add_outer(a, &b.t3, m, v, C64::new(1.0, 0.0));
+            for i in 0..rows {
+                for j in 0..cols {
+                    for m in 0..2 {
+                        let v = self.down[2 * (i * cols + j) + m];
+                        if v[0].norm_sqr() + v[1].norm_sqr() < NEGLIGIBLE {
+                            continue;
+                        }
+                        if want.transmission {
+                            let a = &mut self.transmission[t_base + i * cols + j];
+                            add_outer(a, &b.t2, m, &v, ft);
+                        }
+                        // Uₙ: after the bottom reflection (n + 1 up, j of them e).
+                        for to in 0..2 {
+                            let r = b.r2[(to, m)];
+                            let u = &mut self.up[2 * (i * up_cols + j + to) + to];
+                            u[0] += r * v[0];
+                            u[1] += r * v[1];
+                        }
+                    }
                 }
             }
             // Dₙ₊₁: after the top reflection.
-            let (next_rows, next_cols) = (n + 3, n + 2);
-            self.down[..2 * next_rows * next_cols].fill(z);
-            for (cell, v) in self.up[..2 * rows * up_cols].iter().enumerate() {
-                if v[0].norm_sqr() + v[1].norm_sqr() < NEGLIGIBLE {
-                    continue;
-                }
-                let (ij, m) = (cell / 2, cell % 2);
-                let (i, j) = (ij / up_cols, ij % up_cols);
-                for to in 0..2 {
-                    let r = b.r3[(to, m)];
-                    let d = &mut self.down[2 * ((i + to) * next_cols + j) + to];
-                    d[0] += r * v[0];
-                    d[1] += r * v[1];
+            let next_cols = n + 2;
+            self.down[..2 * (n + 3) * next_cols].fill(z);
+            for i in 0..rows {
+                for j in 0..up_cols {
+                    for m in 0..2 {
+                        let v = self.up[2 * (i * up_cols + j) + m];
+                        if v[0].norm_sqr() + v[1].norm_sqr() < NEGLIGIBLE {
+                            continue;
+                        }
+                        if want.reflection {
+                            let a = &mut self.reflection[r_base + i * up_cols + j];
+                            add_outer(a, &b.t3, m, &v, one);
+                        }
+                        for to in 0..2 {
+                            let r = b.r3[(to, m)];
+                            let d = &mut self.down[2 * ((i + to) * next_cols + j) + to];
+                            d[0] += r * v[0];
+                            d[1] += r * v[1];
+                        }
+                    }
                 }
             }
         }

@@ -16,6 +16,7 @@ use crate::optics::frame::PlaneFrame;
 use crate::optics::modes::ModeKind;
 use crate::plate::slab::{SlabBlocks, BLOCK_VALUES};
 use crate::plate::Plate;
+use crate::scratch::{Pool, Pooled};
 use crate::spectral::fringe;
 use crate::spectral::nodes::{self, FINEST, LEVELS, MAX_NODES, SPAN};
 use num_complex::Complex64 as C64;
@@ -46,7 +47,7 @@ pub struct Amplitudes {
     /// The level (index into [`LEVELS`]).
     pub level: usize,
     /// The blocks at the finest-level node `j`, for the nodes of [`Amplitudes::level`].
-    solved: Store,
+    solved: Pooled<Nodes>,
     /// An isotropic layer: s and p share their phase (one mode count).
     pub merged: bool,
     /// The estimated interpolation error of a block entry on each level up to
@@ -72,17 +73,19 @@ impl Amplitudes {
             } else {
                 0
             },
-            solved: Store::take(),
+            solved: take_nodes(),
             merged: false,
             errors: [0.0; LEVELS.len()],
         };
         loop {
             let lv = nodes::level(out.level);
             for (&j, t) in lv.in_finest.iter().zip(&lv.nodes) {
-                if out.solved[j].is_none() {
+                if out.solved.blocks[j].is_none() {
                     let optics = plate.at(TAU / (k0 + a * t))?.optics(frame, beta)?;
                     out.merged = optics.layer_modes().down[0].kind == ModeKind::S;
-                    out.solved[j] = Some(optics.blocks());
+                    let b = optics.blocks();
+                    out.solved.values[j] = b.values();
+                    out.solved.blocks[j] = Some(b);
                 }
             }
             if out.level == 0 {
@@ -104,7 +107,7 @@ impl Amplitudes {
 
     /// The exact blocks at finest-level node `j`, if it is one of the level's nodes.
     pub fn exact(&self, j: usize) -> Option<&SlabBlocks> {
-        self.solved[j].as_ref()
+        self.solved.blocks[j].as_ref()
     }
 
     /// The blocks at node `i` of `level` (`level ≤` [`Amplitudes::level`]).
@@ -122,7 +125,7 @@ impl Amplitudes {
         let lv = nodes::level(self.level);
         let mut v = [C64::new(0.0, 0.0); BLOCK_VALUES];
         for (&node, w) in lv.in_finest.iter().zip(&lv.to_finest[j]) {
-            let values = self.solved[node].as_ref().expect("solved").values();
+            let values = self.solved.values[node];
             for (o, x) in v.iter_mut().zip(values) {
                 *o += x * *w;
             }
@@ -150,7 +153,7 @@ impl Amplitudes {
         let lv = nodes::level(self.level);
         let mut g = [[C64::new(0.0, 0.0); 4]; SPAN.len()];
         for (i, (&j, tn)) in lv.in_finest.iter().zip(&lv.nodes).enumerate() {
-            let kq = traversal_q(&self.solved[j].as_ref().expect("solved").q)
+            let kq = traversal_q(&self.solved.blocks[j].as_ref().expect("solved").q)
                 .map(|q| q * ((k0 + a * tn) / a));
             for (gs, w) in g.iter_mut().zip(&lv.span_slopes) {
                 for (gm, q) in gs.iter_mut().zip(kq) {
@@ -166,16 +169,17 @@ impl Amplitudes {
     fn estimated_errors(&self) -> [f64; LEVELS.len()] {
         let lv = nodes::level(self.level);
         let n = lv.nodes.len();
-        let blocks: [&SlabBlocks; MAX_NODES] = std::array::from_fn(|i| {
-            let j = lv.in_finest[i.min(n - 1)];
-            self.solved[j].as_ref().expect("solved")
-        });
+        let values = &self.solved.values;
         let mut errors = [0.0f64; LEVELS.len()];
         let mut magnitudes = [0.0; MAX_NODES];
         for &e in &AMPLITUDE_VALUES {
             // The entry's Chebyshev coefficients, c_m = Σ_i dct[m][i] v_i.
             for (mag, row) in magnitudes.iter_mut().zip(&lv.dct) {
-                let c: C64 = row.iter().zip(&blocks).map(|(w, b)| b.value(e) * *w).sum();
+                let c: C64 = row
+                    .iter()
+                    .zip(&lv.in_finest)
+                    .map(|(w, &j)| values[j][e] * *w)
+                    .sum();
                 *mag = c.norm_sqr().sqrt();
             }
             let own = series_tail(&magnitudes[..n]);
@@ -188,43 +192,27 @@ impl Amplitudes {
     }
 }
 
-/// Room for the blocks at every finest-level node (15 kB), taken from a per-thread pool and
-/// given back when dropped: a query neither allocates it nor moves it.
-struct Store(Option<Box<[Option<SlabBlocks>; MAX_NODES]>>);
+/// The blocks at every finest-level node (`None` where not solved) and their values, taken
+/// from a per-thread pool ([`crate::scratch`]): a query neither allocates them nor moves them.
+struct Nodes {
+    blocks: [Option<SlabBlocks>; MAX_NODES],
+    values: [[C64; BLOCK_VALUES]; MAX_NODES],
+}
 
 thread_local! {
-    static POOL: std::cell::RefCell<Vec<Box<[Option<SlabBlocks>; MAX_NODES]>>> =
-        const { std::cell::RefCell::new(Vec::new()) };
+    static POOL: Pool<Nodes> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
-impl Store {
-    fn take() -> Self {
-        let reused = POOL.with(|p| p.borrow_mut().pop());
-        Store(Some(reused.unwrap_or_else(|| Box::new([None; MAX_NODES]))))
-    }
-}
-
-impl std::ops::Deref for Store {
-    type Target = [Option<SlabBlocks>; MAX_NODES];
-    fn deref(&self) -> &Self::Target {
-        self.0.as_ref().expect("a store until dropped")
-    }
-}
-
-impl std::ops::DerefMut for Store {
-    fn deref_mut(&mut self) -> &mut Self::Target {
-        self.0.as_mut().expect("a store until dropped")
-    }
-}
-
-impl Drop for Store {
-    fn drop(&mut self) {
-        if let Some(mut b) = self.0.take() {
-            b.iter_mut().for_each(|x| *x = None);
-            // During thread teardown the pool may be gone: the box is then simply freed.
-            let _ = POOL.try_with(|p| p.borrow_mut().push(b));
-        }
-    }
+/// [`Nodes`] from the pool, cleared.
+fn take_nodes() -> Pooled<Nodes> {
+    let mut n = Pooled::take(&POOL, || {
+        Box::new(Nodes {
+            blocks: [None; MAX_NODES],
+            values: [[C64::new(0.0, 0.0); BLOCK_VALUES]; MAX_NODES],
+        })
+    });
+    n.blocks.iter_mut().for_each(|b| *b = None);
+    n
 }
 
 /// `2 Σ_{m≥n} |c_m|` beyond the `n` known coefficient magnitudes `c`, for a geometric decay
@@ -334,7 +322,7 @@ mod tests {
                                 .in_finest
                                 .iter()
                                 .zip(&lv.to_finest[j])
-                                .map(|(&n, w)| amp.solved[n].unwrap().values()[e] * *w)
+                                .map(|(&n, w)| amp.solved.values[n][e] * *w)
                                 .sum();
                             worst = worst.max((v - exact[e]).norm());
                         }

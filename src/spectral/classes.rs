@@ -104,6 +104,8 @@ struct Placed {
     level: Option<usize>,
     strength: f64,
     group_path: f64,
+    /// The highest order of its classes.
+    order: usize,
     /// Its node shares `ω_ic`: a range of [`Work::omega`], one per amplitude node.
     omega: usize,
 }
@@ -194,17 +196,16 @@ pub fn integrate(
     let visit = std::iter::once(centre).chain((0..own.nodes.len()).filter(|&i| i != centre));
     for i in visit {
         let (j, t) = (own.in_finest[i], own.nodes[i]);
-        let uses = |level: usize| nodes::level(level).in_finest.contains(&j);
+        // Node j's index in each level (None where it is not one of the level's nodes).
+        let index: [Option<usize>; LEVELS.len()] =
+            std::array::from_fn(|l| nodes::level(l).in_finest.iter().position(|&f| f == j));
+        let uses = |level: usize| index[level].is_some();
         let with_tail = uses(tail_level);
         let order = w
             .placed
             .iter()
             .filter(|p| uses(p.amplitude_level))
-            .map(|p| {
-                let g = &layouts[p.lobe].groups[p.group];
-                let (x, y) = layouts[p.lobe].pairs[g.pairs.start];
-                layouts[p.lobe].orders[x as usize].max(layouts[p.lobe].orders[y as usize]) as usize
-            })
+            .map(|p| p.order)
             .max();
         let order = if with_tail { Some(plan.order) } else { order };
         let Some(order) = order else { continue };
@@ -212,26 +213,20 @@ pub fn integrate(
         if i != centre || order != plan.order {
             w.classes.expand(blocks, order, want);
         }
-        for p in w.placed.iter().filter(|p| uses(p.amplitude_level)) {
+        for p in w.placed.iter() {
+            let Some(node) = index[p.amplitude_level] else {
+                continue;
+            };
             let layout = layouts[p.lobe];
-            let node = nodes::level(p.amplitude_level)
-                .in_finest
-                .iter()
-                .position(|&f| f == j)
-                .expect("a node of its level");
             let m = pair_sum(layout, &layout.groups[p.group], &w.classes, p.lobe, output);
-            for (c, acc_c) in acc.iter_mut().enumerate() {
-                add_scaled(&mut acc_c[p.lobe], &m, w.omega[p.omega + node][c], output);
+            let shares = &w.omega[p.omega + node];
+            for (acc_c, share) in acc.iter_mut().zip(shares) {
+                add_scaled(&mut acc_c[p.lobe], &m, *share, output);
             }
         }
-        if with_tail {
+        if let Some(node) = index[tail_level] {
             let lambda = TAU / (k0 + a * t);
             let tail = w.classes.tail(blocks, s.amplitudes.merged, lambda, want);
-            let node = nodes::level(tail_level)
-                .in_finest
-                .iter()
-                .position(|&f| f == j)
-                .expect("a node of the tail's level");
             let wt = tail_rule.weight(0.0, node);
             for (c, t_c) in tails.iter_mut().enumerate() {
                 t_c[0] += tail.r * wt[c].re;
@@ -345,6 +340,7 @@ fn select(
                 level,
                 strength,
                 group_path,
+                order: n,
                 omega: 0,
             });
         }
@@ -637,7 +633,9 @@ fn add_scaled(acc: &mut Matrix4<C64>, m: &Matrix4<C64>, w: C64, output: Output) 
             acc[e] += m[e] * w;
         }
     } else {
-        *acc += m * w;
+        for (a, x) in acc.as_mut_slice().iter_mut().zip(m.as_slice()) {
+            *a += x * w;
+        }
     }
 }
 

@@ -5,6 +5,7 @@ pub mod amplitudes;
 pub mod budget;
 pub mod channel;
 pub mod classes;
+pub mod dense;
 pub mod envelope;
 pub mod fringe;
 pub mod group;

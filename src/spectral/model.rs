@@ -19,6 +19,7 @@ use crate::plate::etalon::Etalon;
 use crate::plate::slab::{Output, SlabMueller, SlabOptics, Want};
 use crate::plate::Plate;
 use crate::spectral::classes;
+use crate::spectral::dense;
 use crate::spectral::envelope;
 use crate::spectral::integrate::{etalon_sum, integrate, integrate_set_exact};
 use crate::spectral::route::{self, Route};
@@ -128,7 +129,7 @@ impl<'a> PlateModel<'a> {
         }
         let survey = Survey::new(self.plate, self.frame, self.beta)?;
         match route::choose(&survey, set)? {
-            Route::Dense(points) => shared::quadrature(
+            Route::Evanescent(points) => shared::quadrature(
                 self.plate,
                 &self.frame,
                 self.beta,
@@ -137,6 +138,7 @@ impl<'a> PlateModel<'a> {
                 want,
                 output,
             ),
+            Route::Dense(points) => dense::integrate(&survey, points, set, want, output),
             Route::Envelope(plan) => envelope::integrate(&survey, &plan, set, want, output),
             Route::Classes(plan) => classes::integrate(&survey, &plan, set, want, output),
         }
