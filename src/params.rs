@@ -248,7 +248,10 @@ mod tests {
         assert!(warn(0.0, 0.0).is_none() && warn(0.0, 0.2).is_none());
         // 3 mm of stressed glass written as 3: 0.6 nm of retardance.
         let w = warn(3.0, 2e-4).unwrap();
-        assert!(w.contains("a retardance of 0.600 nm, 1/917 of a wave"), "{w}");
+        assert!(
+            w.contains("a retardance of 0.600 nm, 1/917 of a wave"),
+            "{w}"
+        );
         assert!(warn(3000.0, 2e-4).is_none());
         assert!(warn(5.01, 2e-4).is_none()); // 1.002 nm
         assert!(warn(4.99, -2e-4).is_some()); // the sign does not matter
@@ -257,7 +260,9 @@ mod tests {
     }
 
     /// Round angles in radians are caught, round angles in degrees (and a textured 0) are not.
+    /// The approximations are the point: they are what users type for π/2, π and 2π.
     #[test]
+    #[allow(clippy::approx_constant)]
     fn angle_warnings() {
         let w = angle_warning("axis_angle", std::f64::consts::FRAC_PI_4).unwrap();
         assert_eq!(
@@ -265,12 +270,37 @@ mod tests {
             "axis_angle: 0.785398 degrees is π/4 in radians (45 degrees); axis_angle is in \
              degrees; if 0.785398 degrees is what you mean, ignore this warning"
         );
-        assert!(angle_warning("a", 0.785).unwrap().contains("π/4 in radians (45 degrees)"));
-        assert!(angle_warning("a", -1.5708).unwrap().contains("-π/2 in radians (-90 degrees)"));
-        assert!(angle_warning("a", 3.1416).unwrap().contains("is π in radians (180 degrees)"));
-        assert!(angle_warning("a", 6.2832).unwrap().contains("2π in radians (360 degrees)"));
-        assert!(angle_warning("a", 2.0944).unwrap().contains("2π/3 in radians"));
-        for quiet in [0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 0.5, 0.79, 7.0, 15.0, 45.0, 90.0, f64::NAN] {
+        assert!(angle_warning("a", 0.785)
+            .unwrap()
+            .contains("π/4 in radians (45 degrees)"));
+        assert!(angle_warning("a", -1.5708)
+            .unwrap()
+            .contains("-π/2 in radians (-90 degrees)"));
+        assert!(angle_warning("a", 3.1416)
+            .unwrap()
+            .contains("is π in radians (180 degrees)"));
+        assert!(angle_warning("a", 6.2832)
+            .unwrap()
+            .contains("2π in radians (360 degrees)"));
+        assert!(angle_warning("a", 2.0944)
+            .unwrap()
+            .contains("2π/3 in radians"));
+        for quiet in [
+            0.0,
+            1.0,
+            2.0,
+            3.0,
+            4.0,
+            5.0,
+            6.0,
+            0.5,
+            0.79,
+            7.0,
+            15.0,
+            45.0,
+            90.0,
+            f64::NAN,
+        ] {
             assert!(angle_warning("a", quiet).is_none(), "{quiet}");
         }
     }

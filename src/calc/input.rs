@@ -36,7 +36,10 @@ impl<'a> Fields<'a> {
             // A length, wavelength or angle without its unit (`thickness` for `thickness_um`).
             let hint = accepted
                 .iter()
-                .find(|a| a.strip_prefix(k.as_str()).is_some_and(|u| u.starts_with('_')))
+                .find(|a| {
+                    a.strip_prefix(k.as_str())
+                        .is_some_and(|u| u.starts_with('_'))
+                })
                 .map(|a| format!("did you mean {a} (the unit is part of the name)? "))
                 .unwrap_or_default();
             return Err(Error::new(
