@@ -158,10 +158,7 @@ fn a_field_without_its_unit_names_the_field_with_it() {
         let msg = v["error"].as_str().unwrap();
         match want {
             Some(w) => assert!(msg.starts_with(w), "{input} -> {msg}"),
-            None => assert!(
-                msg.starts_with("thick: unknown field (accepted: "),
-                "{msg}"
-            ),
+            None => assert!(msg.starts_with("thick: unknown field (accepted: "), "{msg}"),
         }
     }
 }
