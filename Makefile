@@ -44,10 +44,11 @@
 #   make bench-overhead  the overhead table alone (ours against Mitsuba's own plugins, isotropic
 #                 and anisotropic scenes), merged into bench/results.json, docs/benchmarks.md
 #                 and README.md's summary; the other figures are kept
-#   make bench-variants  what each variant costs with the plugins (render time and peak memory
-#                 against scalar_spectral_polarized, interleaved processes: bench/variants.py)
-#                 and the default render's noise and time (bench/default_render.py); printed,
-#                 and written to bench/out/variants.json and default_render.json (~20 min)
+#   make bench-variants  what each variant costs with the plugins (render time against
+#                 scalar_spectral_polarized in alternating pairs, peak memory of a process per
+#                 variant: bench/variants.py) and the default render's noise per sampler and
+#                 time (bench/default_render.py); printed, and written to bench/out/variants.json
+#                 and default_render.json (25 and 75 min on 2 cores at load average 6-12)
 
 SHELL := bash
 .SHELLFLAGS := -euo pipefail -c
