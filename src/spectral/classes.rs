@@ -63,7 +63,8 @@ const PHASE_LEVEL: usize = 4;
 /// measures that error). `None` if the orders do not converge (`ρ ≥ 1`).
 pub fn plan(s: &Survey, set: WeightSet) -> Option<Plan> {
     let rho = s.rho;
-    if !(rho < 1.0) {
+    // `ρ ≥ 1` or NaN: the orders do not converge.
+    if rho.is_nan() || rho >= 1.0 {
         return None;
     }
     let rule = fringe::rule(set, 0);

@@ -86,7 +86,7 @@ struct Rates {
 
 impl Rates {
     fn of(s: &Survey) -> Option<Self> {
-        if !(s.rho < 1.0) {
+        if s.rho.is_nan() || s.rho >= 1.0 {
             return None;
         }
         let base = |down: bool| {

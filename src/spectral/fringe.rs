@@ -168,7 +168,7 @@ impl FringeRule {
         let n = self.nodes.len();
         let s = g.abs() / STEP_NM;
         let mut out = [C64::new(0.0, 0.0); 3];
-        if !(s < (self.rows - 2) as f64) {
+        if s.is_nan() || s >= (self.rows - 2) as f64 {
             return out;
         }
         let m = s.floor() as usize;

@@ -71,11 +71,14 @@ pub fn layout(lobe: Lobe, order: usize, absorbing: bool) -> &'static Layout {
     ALL[l][order][usize::from(absorbing)].get_or_init(|| Layout::build(lobe, order, absorbing))
 }
 
+/// A pair of classes keyed for grouping: (orders, Δ counts, summed counts, class a, class b).
+type Keyed = ((usize, usize), [i32; 4], [i32; 4], u16, u16);
+
 impl Layout {
     fn build(lobe: Lobe, order: usize, absorbing: bool) -> Self {
         let n = lobe.classes(order);
         let classes: Vec<(Counts, usize)> = (0..n).map(|k| lobe.class(k)).collect();
-        let mut keyed: Vec<((usize, usize), [i32; 4], [i32; 4], u16, u16)> = Vec::new();
+        let mut keyed: Vec<Keyed> = Vec::new();
         for a in 0..n {
             for b in a..n {
                 let (ca, cb) = (classes[a].0, classes[b].0);

@@ -141,7 +141,8 @@ impl Rule {
 /// computed once.
 pub fn node_basis(set: WeightSet, points: usize, level: usize) -> &'static [[f64; MAX_NODES]] {
     const SETS: usize = WeightSet::ALL.len();
-    static BASES: [[[OnceLock<Vec<[f64; MAX_NODES]>>; LEVELS.len()]; LADDER.len()]; SETS] =
+    type Basis = OnceLock<Vec<[f64; MAX_NODES]>>;
+    static BASES: [[[Basis; LEVELS.len()]; LADDER.len()]; SETS] =
         [const { [const { [const { OnceLock::new() }; LEVELS.len()] }; LADDER.len()] }; SETS];
     let rung = LADDER
         .iter()
