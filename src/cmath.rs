@@ -111,14 +111,19 @@ pub fn inv(z: C64) -> C64 {
 /// Solves `A X = B` for a 4×4 complex `A` and 4×4 `B` by Gaussian elimination with partial
 /// pivoting; `None` if `A` is singular to working precision.
 pub fn solve4(a: &Matrix4<C64>, b: &Matrix4<C64>) -> Option<Matrix4<C64>> {
-    // Rows of the augmented system [A | B].
-    let mut m = [[C64::new(0.0, 0.0); 8]; 4];
-    for (i, row) in m.iter_mut().enumerate() {
-        for j in 0..4 {
-            row[j] = a[(i, j)];
-            row[4 + j] = b[(i, j)];
-        }
-    }
+    let x = solve4_columns(a, &[*b])?;
+    Some(x[0])
+}
+
+/// [`solve4`] for several right-hand sides at once (one elimination).
+pub fn solve4_columns<const N: usize>(
+    a: &Matrix4<C64>,
+    b: &[Matrix4<C64>; N],
+) -> Option<[Matrix4<C64>; N]> {
+    // Rows of A, and of every B, eliminated together.
+    let mut m: [[C64; 4]; 4] = std::array::from_fn(|i| std::array::from_fn(|j| a[(i, j)]));
+    let mut r: [[[C64; 4]; N]; 4] =
+        std::array::from_fn(|i| std::array::from_fn(|k| std::array::from_fn(|j| b[k][(i, j)])));
     let scale = a.iter().map(|z| z.norm_sqr()).fold(0.0, f64::max);
     for col in 0..4 {
         let mut pivot = col;
@@ -132,25 +137,48 @@ pub fn solve4(a: &Matrix4<C64>, b: &Matrix4<C64>) -> Option<Matrix4<C64>> {
             return None;
         }
         m.swap(col, pivot);
-        let inv = p.inv();
-        let pivot_row = {
-            let r = &mut m[col];
-            for v in r.iter_mut().skip(col) {
+        r.swap(col, pivot);
+        let inv = inv(p);
+        for v in m[col].iter_mut().skip(col) {
+            *v *= inv;
+        }
+        for block in r[col].iter_mut() {
+            for v in block.iter_mut() {
                 *v *= inv;
             }
-            *r
-        };
-        for (i, row) in m.iter_mut().enumerate() {
+        }
+        let (pm, pr) = (m[col], r[col]);
+        for i in 0..4 {
             if i == col {
                 continue;
             }
-            let f = row[col];
-            for j in col..8 {
-                row[j] -= f * pivot_row[j];
+            let f = m[i][col];
+            for j in col..4 {
+                m[i][j] -= f * pm[j];
+            }
+            for (block, pb) in r[i].iter_mut().zip(&pr) {
+                for (v, pv) in block.iter_mut().zip(pb) {
+                    *v -= f * pv;
+                }
             }
         }
     }
-    Some(Matrix4::from_fn(|i, j| m[i][4 + j]))
+    Some(std::array::from_fn(|k| Matrix4::from_fn(|i, j| r[i][k][j])))
+}
+
+/// `a b` for 4×4 complex matrices, written out (the generic product is several times slower).
+#[inline]
+pub fn mul4(a: &Matrix4<C64>, b: &Matrix4<C64>) -> Matrix4<C64> {
+    let mut out = Matrix4::zeros();
+    for j in 0..4 {
+        for k in 0..4 {
+            let bkj = b[(k, j)];
+            for i in 0..4 {
+                out[(i, j)] += a[(i, k)] * bkj;
+            }
+        }
+    }
+    out
 }
 
 /// Uniform numbers in `[0, 1)` from a 64-bit linear congruential generator (Knuth's MMIX

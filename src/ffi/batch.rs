@@ -13,11 +13,12 @@ use super::samples::Output;
 use super::spectrum::PlateSpectrum;
 use super::tangents::{crystal_inputs, plate_inputs, TangentOutput};
 use crate::error::{Error, Result};
+use crate::material::Material;
 use crate::optics::medium::Uniaxial;
 use crate::optics::surface::Surface;
 use crate::params::{Length, Thickness};
 use crate::render::choice::{choose, Choice};
-use crate::render::crystal::crystal_slots;
+use crate::render::crystal::fill_crystal_slots;
 use crate::render::plate::{plate_lobes, PlateQuery, Spectrum, MAX_BANDS};
 use crate::render::slots::{crystal_component, plate_component, Slots, CRYSTAL_SLOTS, PLATE_SLOTS};
 use crate::render::tangents::{Columns, Input, Lane, Point};
@@ -29,8 +30,9 @@ const _: () = assert!(MAX_CHANNELS == MAX_BANDS);
 const _: () = assert!(Bounds::MaxChannels.repr as usize == MAX_CHANNELS);
 const _: () = assert!(Bounds::PlateComponents.repr as usize == PLATE_SLOTS);
 
-/// One lane's lobes per channel and the slot chosen among them.
-type Sampled<const S: usize> = Option<([Slots<S>; MAX_CHANNELS], Choice)>;
+/// One lane's lobes per channel: filled in place by a lane (a crystal's are 8 KB, which moving
+/// by value cost more than computing an isotropic crystal's lobes).
+type Lobes<const S: usize> = [Slots<S>; MAX_CHANNELS];
 
 /// Samples a plate lobe in every lane (see `bridge::sample_plate`).
 pub fn sample_plate(
@@ -97,7 +99,7 @@ fn plate_batch(
             None => None,
         };
         let mut output = Output::new(out, lanes.count, channels)?;
-        let lane = |i| plate_lane(materials, spectrum, call, &cols, i);
+        let lane = |i, lobes: &mut _| plate_lane(materials, spectrum, call, &cols, i, lobes);
         let derive = |i, lobes: &[Slots<PLATE_SLOTS>], choice, inputs: &[Input], out: &mut _| {
             plate_derivatives(
                 materials,
@@ -149,7 +151,7 @@ fn crystal_batch(
             None => None,
         };
         let mut output = Output::new(out, lanes.count, channels)?;
-        let lane = |i| crystal_lane(materials, components, &cols, i);
+        let lane = |i, lobes: &mut _| crystal_lane(materials, components, &cols, i, lobes);
         let derive = |i, lobes: &[Slots<CRYSTAL_SLOTS>], choice, inputs: &[Input], out: &mut _| {
             crystal_derivatives(materials, &cols, i, (lobes, choice), (inputs, !full), out)
         };
@@ -175,17 +177,19 @@ fn finish(r: Result<Status>, out: &mut Samples) -> Status {
     })
 }
 
-/// Computes each of the call's `count` lanes (`lane(i)`, skipping inactive ones) and writes it,
-/// with its derivatives (`derive`) if `tangents` asks for them.
+/// Computes each of the call's `count` lanes (`lane(i, lobes)`, skipping inactive ones) and
+/// writes it, with its derivatives (`derive`) if `tangents` asks for them. A lane fills the
+/// channels' slots of `lobes` (one buffer for the call) and returns the chosen slot, if any.
 fn write_lanes<const S: usize>(
     output: &mut Output,
     mut tangents: Option<&mut TangentOutput>,
     count: usize,
     active: &Column<u8>,
-    lane: impl Fn(usize) -> Result<Sampled<S>>,
+    lane: impl Fn(usize, &mut Lobes<S>) -> Result<Option<Choice>>,
     derive: impl Fn(usize, &[Slots<S>], Choice, &[Input], &mut Columns) -> Result<()>,
     component: fn(usize) -> usize,
 ) {
+    let mut lobes = [[None; S]; MAX_CHANNELS];
     // One lane's derivatives, reused lane after lane (allocated only when asked for).
     let mut scratch = tangents.as_ref().map(|_| Box::new(Columns::zeros()));
     for i in 0..count {
@@ -195,7 +199,15 @@ fn write_lanes<const S: usize>(
             let derive = scratch
                 .as_deref_mut()
                 .map(|out| move |lobes: &[Slots<S>], choice| derive(i, lobes, choice, inputs, out));
-            write_lane(output, i, active.at(i), || lane(i), derive, component)
+            write_lane(
+                output,
+                i,
+                active.at(i),
+                |l| lane(i, l),
+                &mut lobes,
+                derive,
+                component,
+            )
         };
         if let Some(t) = tangents.as_deref_mut() {
             let d = scratch.as_deref().filter(|_| derived);
@@ -210,13 +222,14 @@ fn write_lanes<const S: usize>(
     }
 }
 
-/// Computes lane `i` (unless inactive) and writes it, and its derivatives with `derive` if
-/// given; returns whether they were derived (the lane samples a lobe).
+/// Computes lane `i` (unless inactive) into `lobes` and writes it, and its derivatives with
+/// `derive` if given; returns whether they were derived (the lane samples a lobe).
 fn write_lane<const S: usize>(
     output: &mut Output,
     i: usize,
     active: u8,
-    lane: impl FnOnce() -> Result<Sampled<S>>,
+    lane: impl FnOnce(&mut Lobes<S>) -> Result<Option<Choice>>,
+    lobes: &mut Lobes<S>,
     derive: Option<impl FnOnce(&[Slots<S>], Choice) -> Result<()>>,
     component: fn(usize) -> usize,
 ) -> bool {
@@ -224,8 +237,8 @@ fn write_lane<const S: usize>(
         output.nothing(i);
         return false;
     }
-    let written = guarded(lane).and_then(|sampled| match sampled {
-        Some((lobes, choice)) => {
+    let written = guarded(|| lane(lobes)).and_then(|choice| match choice {
+        Some(choice) => {
             let channels = &lobes[..output.channels()];
             output.write(i, channels, choice, component(choice.slot))?;
             match derive {
@@ -428,7 +441,8 @@ fn plate_lane(
     call: &PlateCall,
     cols: &PlateColumns,
     i: usize,
-) -> Result<Sampled<PLATE_SLOTS>> {
+    lobes: &mut Lobes<PLATE_SLOTS>,
+) -> Result<Option<Choice>> {
     let c = &cols.common;
     let (transport, u) = c.transport_and_sample(i)?;
     let point = plate_point(materials, cols, i)?;
@@ -442,7 +456,6 @@ fn plate_lane(
         |slot| enabled(call.components, plate_component(slot)),
         u,
     );
-    let mut lobes = [[None; PLATE_SLOTS]; MAX_CHANNELS];
     match pick {
         Some(k) => lobes[0] = per_channel[k],
         None => {
@@ -455,7 +468,7 @@ fn plate_lane(
         hero: if pick.is_some() { 0 } else { choice.hero },
         ..choice
     };
-    Ok(choice.map(|choice| (lobes, kept(choice))))
+    Ok(choice.map(kept))
 }
 
 /// The derivatives with respect to `inputs` of lane `i` of a plate batch, which sampled
@@ -508,24 +521,28 @@ fn crystal_point(materials: &Materials, cols: &CrystalColumns, i: usize) -> Resu
     })
 }
 
-/// The crystal's slots per wavelength at point `p` of lane `i`, into `slots` (one per
-/// wavelength column).
+/// The crystal's slots per wavelength of lane `i` (`material`, `axis` and `wi`: the lane's or a
+/// moved point's), into `slots` (one per wavelength column).
 fn crystal_at(
     cols: &CrystalColumns,
     i: usize,
-    p: &Point,
+    (material, axis, wi): (&Material, Vector3<f64>, Vector3<f64>),
     transport: Transport,
     slots: &mut [Slots<CRYSTAL_SLOTS>],
 ) -> Result<()> {
     let c = &cols.common;
     let ext = C64::new(c.ext_ior.at(i), 0.0);
-    for (s, &lambda) in slots
-        .iter_mut()
-        .zip(&c.wavelengths.at(i)[..c.wavelengths.count()])
-    {
-        let (eo, ee) = p.material.indices(lambda, 0.0)?;
-        let surface = Surface::new(ext, Uniaxial::new(eo, ee, p.axis)?)?;
-        *s = crystal_slots(&surface, p.wi, transport)?;
+    let mut last: Option<(C64, C64)> = None;
+    for k in 0..slots.len() {
+        let indices = material.indices(c.wavelengths.at(i)[k], 0.0)?;
+        if last == Some(indices) {
+            // The same indices (a constant material) give the same lobes, bit for bit.
+            slots[k] = slots[k - 1];
+            continue;
+        }
+        let surface = Surface::new(ext, Uniaxial::new(indices.0, indices.1, axis)?)?;
+        fill_crystal_slots(&surface, wi, transport, &mut slots[k])?;
+        last = Some(indices);
     }
     Ok(())
 }
@@ -536,19 +553,19 @@ fn crystal_lane(
     components: u32,
     cols: &CrystalColumns,
     i: usize,
-) -> Result<Sampled<CRYSTAL_SLOTS>> {
+    lobes: &mut Lobes<CRYSTAL_SLOTS>,
+) -> Result<Option<Choice>> {
     let c = &cols.common;
     let (transport, u) = c.transport_and_sample(i)?;
+    let material = materials.get(c.material.at(i))?;
     let channels = c.wavelengths.count();
-    let mut lobes = [[None; CRYSTAL_SLOTS]; MAX_CHANNELS];
-    let point = crystal_point(materials, cols, i)?;
-    crystal_at(cols, i, &point, transport, &mut lobes[..channels])?;
-    let choice = choose(
+    let lane = (material, c.optic_axis.at(i), c.wi.at(i));
+    crystal_at(cols, i, lane, transport, &mut lobes[..channels])?;
+    Ok(choose(
         &lobes[..channels],
         |slot| enabled(components, crystal_component(slot)),
         u,
-    );
-    Ok(choice.map(|choice| (lobes, choice)))
+    ))
 }
 
 /// The derivatives with respect to `inputs` of lane `i` of a crystal batch, which sampled
@@ -565,7 +582,7 @@ fn crystal_derivatives(
     let (transport, _) = c.transport_and_sample(i)?;
     let at = |p: &Point| {
         let mut slots = vec![[None; CRYSTAL_SLOTS]; c.wavelengths.count()];
-        crystal_at(cols, i, p, transport, &mut slots).map(|_| slots)
+        crystal_at(cols, i, (&p.material, p.axis, p.wi), transport, &mut slots).map(|_| slots)
     };
     let lane = Lane {
         point: crystal_point(materials, cols, i)?,
