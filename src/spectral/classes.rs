@@ -59,8 +59,8 @@ const PHASE_LEVEL: usize = 4;
 /// pairs fall below [`ORDER_TAIL`] (across orders: `ρⁿ` times the visibility of `n` round
 /// trips; within an order, where mode conversions keep paths of equal counts coherent:
 /// `ρ^{2n}`), at most [`MAX_ORDER`] (beyond, the tail takes the rest: plates near grazing
-/// incidence, where the round trip reflects nearly everything; `tests/spectral_grazing.rs`
-/// measures that error). `None` if the orders do not converge (`ρ ≥ 1`).
+/// incidence, where the round trip reflects nearly everything; docs/physics.md §4, "Known
+/// limitations", gives that error as measured). `None` if the orders do not converge (`ρ ≥ 1`).
 pub fn plan(s: &Survey, set: WeightSet) -> Option<Plan> {
     let rho = s.rho;
     // `ρ ≥ 1` or NaN: the orders do not converge.
