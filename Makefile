@@ -37,10 +37,13 @@
 #                 survives or no longer applies (tools/mutants.py; MUTANTS=id,id runs only those)
 #   make bench    make setup, then the core benchmark on one core (taskset -c 0) and its plot:
 #                 bench/out/core.json, bench/out/core_error_vs_time.png (several minutes), then
-#                 make bench-scenes and make bench-jit
+#                 make bench-scenes, make bench-jit and make bench-gradients
 #   make bench-jit  the plugins in the llvm variants (evaluated mode): render time against
 #                 Mitsuba's dielectric/thindielectric and against the scalar variants, peak
 #                 memory; bench/out/jit.json and bench/out/jit.png
+#   make bench-gradients  gradient renders of the photoelastic disk (llvm_ad_spectral_polarized):
+#                 time and peak memory of a primal, a forward- and a reverse-mode gradient
+#                 render; bench/out/gradients.json
 #   make bench-scenes  the scene benchmarks alone: the core's shortcuts (examples/bench_shortcuts.rs,
 #                 one core), error vs time per scene, overhead against Mitsuba's own plugins;
 #                 writes bench/results.json, bench/out/ (JSON, PNG plots), docs/benchmarks.md
@@ -82,7 +85,7 @@ PLUGIN_BUILT := target/release/libmitsuba_birefringent.so
 # site-packages of .venv/ (evaluated when used: the venv may not exist yet when make starts)
 SITE = $(shell $(VPY) -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')
 
-.PHONY: help setup build venv llvm plugin plugin-lib render gallery test test-rust test-python mutants fuzz fuzz-ci bench bench-scenes bench-overhead bench-jit bench-variants fmt lint clean distclean
+.PHONY: help setup build venv llvm plugin plugin-lib render gallery test test-rust test-python mutants fuzz fuzz-ci bench bench-scenes bench-overhead bench-jit bench-variants bench-gradients fmt lint clean distclean
 
 help:
 	@sed -n '3,/^$$/s/^# \{0,1\}//p' $(firstword $(MAKEFILE_LIST))
@@ -247,6 +250,7 @@ bench: setup
 	$(VPY) bench/plot_core.py $(BENCH_OUT)/core.json $(BENCH_OUT)/core_error_vs_time.png
 	$(MAKE) --no-print-directory bench-scenes
 	$(MAKE) --no-print-directory bench-jit
+	$(MAKE) --no-print-directory bench-gradients
 
 # bench/jit.py: the overhead scenes of bench/scenes.py in every llvm variant in evaluated mode
 # (ours against Mitsuba's own plugins, and against ours in the scalar variants), interleaved
@@ -254,6 +258,14 @@ bench: setup
 bench-jit: setup
 	@mkdir -p $(BENCH_OUT)
 	$(VPY) bench/jit.py --out $(BENCH_OUT)
+
+# bench/gradients.py: a primal, forward- and reverse-mode gradient renders of the photoelastic
+# disk in llvm_ad_spectral_polarized (the plate's birefringence texture, its thickness, and a
+# parameter of Mitsuba's own retarder for comparison), interleaved in one process (CPU and wall
+# time), peak memory in one process per configuration.
+bench-gradients: setup
+	@mkdir -p $(BENCH_OUT)
+	$(VPY) bench/gradients.py --out $(BENCH_OUT)
 
 # examples/bench_shortcuts.rs (speed ratios of the core's shortcuts, one core), then
 # bench/scenes.py (every scene module of scenes/: error vs time against an exact

@@ -10,7 +10,9 @@ scene's default width and height) with `--spp` samples per pixel and the sampler
 transmission), unless the module has a dict
 `GALLERY` of options for the gallery (e.g. fewer samples for a costly scene). Each goes to
 `<out>/<name>.exr` and `.png` (`render.render`); the contact sheet has the images in a grid with
-the scene's name and the first paragraph of its docstring under each.
+the scene's name and the first paragraph of its docstring under each. The examples of EXAMPLES
+(not scenes: e.g. an optimisation through the renderer) make their own figure with their
+`gallery(out)` function.
 """
 
 from __future__ import annotations
@@ -28,6 +30,9 @@ HERE = pathlib.Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
 import render  # noqa: E402
+
+#: Modules with a `gallery(out) -> png` function, shown after the scenes.
+EXAMPLES = ("inverse_photoelastic",)
 
 
 def gallery_options(module, width: int, spp: int) -> dict:
@@ -87,6 +92,15 @@ def main() -> None:
         if not (a.reuse and png.exists()):
             png = render.render(name, a.out, sampler=a.sampler,
                                 **gallery_options(module, a.width, a.spp))
+        caption = " ".join((module.__doc__ or "").strip().split("\n\n")[0].split())
+        entries.append((name, caption, png))
+    for name in EXAMPLES:
+        if a.only and name not in a.only:
+            continue
+        module = importlib.import_module(name)
+        png = a.out / f"{name}.png"
+        if not (a.reuse and png.exists()):
+            png = module.gallery(a.out)
         caption = " ".join((module.__doc__ or "").strip().split("\n\n")[0].split())
         entries.append((name, caption, png))
     contact_sheet(entries, a.sheet)

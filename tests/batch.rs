@@ -407,7 +407,8 @@ fn crystal_expected(
 
 /// The choice documented in src/render/choice.rs, written here apart from `choose` (which the
 /// batch calls): the candidates are the enabled slots that some channel has, each weighted by
-/// its |M00| summed over the channels; a lone candidate is taken with probability 1; else `u`
+/// its power fraction's |M00| (`PathLobe::power`: without Radiance mode's radiance factor)
+/// summed over the channels; a lone candidate is taken with probability 1; else `u`
 /// walks the cumulative weights of the slots of positive weight in slot order (the first whose
 /// running sum exceeds `u * total`, the last one if rounding leaves none), with probability
 /// weight / total; the ray follows the slot in the first channel that has it (the hero). The
@@ -425,7 +426,7 @@ fn expected_choice<const S: usize>(
                 lobes
                     .iter()
                     .filter_map(|c| c[s])
-                    .map(|l| l.weight.abs())
+                    .map(|l| l.power.abs())
                     .sum(),
             )
         })
@@ -700,10 +701,11 @@ fn the_choice_is_an_unbiased_sampler_of_every_channel() {
                 (*count, *pdf, *v) = (*count + 1, out.pdf[k], value);
             }
             // A slot the grid never picks must be one of probability below a grid step: one
-            // whose |M00|, summed over the channels, is below 1/K of the lobes' total.
+            // whose power fraction (|M00|), summed over the channels, is below 1/K of the
+            // lobes' total.
             let weight = |slot: usize| -> f64 {
                 let w = lobes.iter().take(channels).filter_map(|c| c[slot]);
-                w.map(|l| l.weight.abs()).sum()
+                w.map(|l| l.power.abs()).sum()
             };
             let all = weight(0) + weight(1);
             let total: f64 = picked.iter().filter(|p| p.0 > 0).map(|p| p.1).sum();

@@ -25,7 +25,7 @@ Bulk birefringent crystal (:monosp:`birefringent`)
      an isotropic glass; not together with ``material``), within [1e-3, 1e3] (as is every
      index). Floats only: an index that varies with wavelength is a ``material``. Exposed only
      when given (or when a plate's glass default stands for them).
-   - |exposed|
+   - |exposed|, |differentiable|
 
  * - kappa_o, kappa_e
    - |float|
@@ -36,13 +36,13 @@ Bulk birefringent crystal (:monosp:`birefringent`)
      :monosp:`thinbirefringent` for a dichroic plate). An absorbing bulk is opaque, like
      :monosp:`conductor`: what refracts into it is absorbed at the surface, so there is the
      reflection alone from outside and nothing from inside. (Default: 0)
-   - |exposed|
+   - |exposed|, |differentiable|
 
  * - optic_axis
    - |vector|
    - The optic axis, any non-zero length, in the frame that ``optic_axis_space`` names.
      (Default: ``[1, 0, 0]``, said in a warning at load for a birefringent material)
-   - |exposed|
+   - |exposed|, |differentiable|
 
  * - optic_axis_space
    - |string|
@@ -95,6 +95,7 @@ double refraction needs a polarized variant; an isotropic material (``eta_o == e
         'optic_axis_space': 'world'
 */
 #include "plugins.h"
+#include "differentiable.h"
 #include "last_valid.h"
 
 NAMESPACE_BEGIN(mitsuba)
@@ -131,10 +132,10 @@ public:
     Birefringent(const Properties &props) : Base(props) {
         shim::refuse_foreign(props, Foreign, ClassName);
         shim::Defaults defaults;
-        m_params = shim::parse_material(props, ClassName, defaults);
+        shim::MaterialParams material = shim::parse_material(props, ClassName, defaults);
         m_ext_ior = shim::parse_ior(props, "ext_ior", "air", ClassName);
         shim::require_vector(props, "optic_axis", ClassName);
-        m_optic_axis = props.get<ScalarVector3f>("optic_axis", ScalarVector3f(1.f, 0.f, 0.f));
+        m_diff.set(material, props.get<ScalarVector3f>("optic_axis", ScalarVector3f(1.f, 0.f, 0.f)));
         std::string space = props.get<std::string>("optic_axis_space", "local");
         if (space != "local" && space != "world")
             Throw("\"optic_axis_space\" must be \"local\" (the shading frame) or \"world\", got \"%s\"", space);
@@ -149,15 +150,11 @@ public:
         defaults.log(ClassName);
     }
 
+    /// eta_o, eta_e, kappa_o, kappa_e and optic_axis are differentiable in the JIT variants
+    /// (differentiable.h); ext_ior is not.
     void traverse(TraversalCallback *cb) override {
-        if (!m_params.named) {
-            cb->put("eta_o", m_params.eta_o, ParamFlags::NonDifferentiable);
-            cb->put("eta_e", m_params.eta_e, ParamFlags::NonDifferentiable);
-        }
-        cb->put("kappa_o", m_params.kappa_o, ParamFlags::NonDifferentiable);
-        cb->put("kappa_e", m_params.kappa_e, ParamFlags::NonDifferentiable);
+        m_diff.traverse(cb);
         cb->put("ext_ior", m_ext_ior, ParamFlags::NonDifferentiable);
-        cb->put("optic_axis", m_optic_axis, ParamFlags::NonDifferentiable);
     }
 
     /// Applies changed parameters; a rejected update leaves the last valid state in force
@@ -169,14 +166,15 @@ public:
 private:
     /// Rebuilds the core material and the flags, and checks every parameter with one core query.
     void rebuild() {
-        m_material = shim::make_material(m_params, ClassName);
+        auto [material, axis] = m_diff.updated();
+        m_material = shim::make_material(material, ClassName);
         bool isotropic = m_material->is_isotropic(0);
         if (!is_polarized_v<Spectrum> && !isotropic)
             Throw("double refraction (eta_o != eta_e, or a named crystal: %s) needs a polarized "
                   "variant, which carries whether a ray in the crystal is ordinary or "
                   "extraordinary: use scalar_spectral_polarized, llvm_ad_spectral_polarized or "
                   "llvm_ad_mono_polarized. In this variant only an isotropic material "
-                  "(eta_o == eta_e, kappa_o == kappa_e) works.", m_params.to_string());
+                  "(eta_o == eta_e, kappa_o == kappa_e) works.", material.to_string());
         uint32_t aniso = isotropic ? 0u : (uint32_t) BSDFFlags::Anisotropic;
         uint32_t sides = (uint32_t) (BSDFFlags::FrontSide | BSDFFlags::BackSide) | aniso;
         m_types[0] = BSDFFlags::DeltaReflection;
@@ -192,7 +190,8 @@ private:
                                    (asym ? (uint32_t) BSDFFlags::NonSymmetric : 0u));
         }
         m_flags = m_components[0] | m_components[1] | m_components[2];
-        check_at_load();
+        check_at_load(axis);
+        m_diff.commit(material, axis);
     }
 
 public:
@@ -223,9 +222,9 @@ public:
     std::string to_string() const override {
         std::ostringstream oss;
         oss << "Birefringent[" << std::endl
-            << "  " << m_params.to_string() << "," << std::endl
+            << "  " << m_diff.material.to_string() << "," << std::endl
             << "  ext_ior = " << m_ext_ior << "," << std::endl
-            << "  optic_axis = " << m_optic_axis << " (" << (m_axis_in_world ? "world" : "local")
+            << "  optic_axis = " << m_diff.axis << " (" << (m_axis_in_world ? "world" : "local")
             << " frame)";
         if constexpr (is_monochromatic_v<Spectrum>)
             oss << "," << std::endl << "  channel = \"" << m_channel << "\" (at " << m_wavelength << " nm)";
@@ -241,8 +240,8 @@ private:
     static_assert(WiY == WiX + 1 && WiZ == WiX + 2 && Sample == WiX + 3, "shim::fill_path_lanes");
 
     /// One core query at normal incidence, at the variant's wavelength (550 nm in the spectral
-    /// ones), with the axis as given; throws its message.
-    void check_at_load() const {
+    /// ones), with the axis `optic_axis` as given; throws its message.
+    void check_at_load(const ScalarVector3f &optic_axis) const {
         shim::ChunkBuffers<1> b;
         const uint8_t one = 1;
         const uint32_t material = 0;
@@ -259,9 +258,9 @@ private:
         b.constant(Wavelength0, m_wavelength);
         lanes.wavelengths_nm = b.wavelength_columns(Wavelength0, 1);
         lanes.ext_ior = b.constant(ExtIor, m_ext_ior).slice();
-        lanes.optic_axis = { b.constant(AxisX, m_optic_axis.x()).slice(),
-                             b.constant(AxisY, m_optic_axis.y()).slice(),
-                             b.constant(AxisZ, m_optic_axis.z()).slice() };
+        lanes.optic_axis = { b.constant(AxisX, optic_axis.x()).slice(),
+                             b.constant(AxisY, optic_axis.y()).slice(),
+                             b.constant(AxisZ, optic_axis.z()).slice() };
         bfr::Samples s = b.samples(1, 1, true);
         bfr::Status rc = bfr::sample_crystal(*m_material, 7u, lanes, s);
         if (rc != bfr::Status::Ok)
@@ -277,17 +276,24 @@ private:
         shim::HostInputs<Float> in;
         const shim::PathColumns path = shim::add_path_inputs<Float, Spectrum>(in, si, sample1, active);
         size_t k_axis = 0;
+        // The axis in the shading frame: in world space, it moves with the frame.
+        Vector3f axis = m_diff.optic_axis();
         if (m_axis_in_world) {
-            Vector3f a = si.to_local(Vector3f(m_optic_axis));
-            k_axis = in.add(a.x());
-            in.add(a.y());
-            in.add(a.z());
+            axis = si.to_local(axis);
+            k_axis = in.add(axis.x());
+            in.add(axis.y());
+            in.add(axis.z());
         }
         // One wavelength column in the RGB and mono variants (m_wavelength).
         const size_t waves = is_spectral_v<Spectrum> ? path.waves : 1;
         Answers answers;
         size_t n = in.width();
-        answers.allocate(n);
+        answers.allocate(n, tangent_inputs(si, axis));
+        const shim::TangentInputs<Float> &tangents = answers.tangents();
+        if (!tangents.empty())
+            shim::core_call(ClassName, [&] {
+                bfr::crystal_tangents_available(*m_material, tangents.request());
+            });
         in.read();
 
         bool radiance = mode == TransportMode::Radiance;
@@ -309,16 +315,25 @@ private:
                                      b.convert(AxisY, in.floats(k_axis + 1), begin, end).slice(),
                                      b.convert(AxisZ, in.floats(k_axis + 2), begin, end).slice() };
             else
-                lanes.optic_axis = { b.constant(AxisX, m_optic_axis.x()).slice(),
-                                     b.constant(AxisY, m_optic_axis.y()).slice(),
-                                     b.constant(AxisZ, m_optic_axis.z()).slice() };
+                lanes.optic_axis = { b.constant(AxisX, m_diff.axis.x()).slice(),
+                                     b.constant(AxisY, m_diff.axis.y()).slice(),
+                                     b.constant(AxisZ, m_diff.axis.z()).slice() };
             bfr::Samples s = b.samples(lanes.count, waves, is_polarized_v<Spectrum>);
-            bfr::Status rc = bfr::sample_crystal(*m_material, components, lanes, s);
+            bfr::Status rc;
+            if (tangents.empty()) {
+                rc = bfr::sample_crystal(*m_material, components, lanes, s);
+            } else {
+                bfr::Tangents t = shim::tangent_columns(b, tangents.request(), tangents.columns(),
+                                                        lanes.count, waves, is_polarized_v<Spectrum>);
+                rc = bfr::sample_crystal_tangents(*m_material, components, lanes, t, s);
+            }
             for (size_t j = 0; j < lanes.count; ++j) {
                 size_t i = begin + j;
                 Vec3d wi(in.floats(path.wi[0]).at(i), in.floats(path.wi[1]).at(i),
                          in.floats(path.wi[2]).at(i));
                 answers.write(b, lanes.count, j, waves, wi, radiance, std::nullopt, m_types, i);
+                if (!tangents.empty())
+                    answers.write_tangents(b, lanes.count, j, waves, i);
             }
             return rc == bfr::Status::Ok ? std::string() : shim::core_message(rc, s.message);
         });
@@ -327,10 +342,27 @@ private:
         return answers.sample();
     }
 
-    shim::MaterialParams m_params;
+    /// The inputs of a query that carry gradients: the handles of the scalar parameters, the
+    /// optic axis in the shading frame (`axis`: with the frame's gradients when given in world
+    /// space), si.wi.
+    shim::TangentInputs<Float> tangent_inputs(const SurfaceInteraction3f &si,
+                                              const Vector3f &axis) const {
+        shim::TangentInputs<Float> t;
+        if (!m_diff.material.named) {
+            t.add(bfr::Tangent::EtaO, m_diff.eta_o());
+            t.add(bfr::Tangent::EtaE, m_diff.eta_e());
+        }
+        t.add(bfr::Tangent::KappaO, m_diff.kappa_o());
+        t.add(bfr::Tangent::KappaE, m_diff.kappa_e());
+        t.add(bfr::Tangent::OpticAxis, axis);
+        t.add(bfr::Tangent::Wi, si.wi);
+        return t;
+    }
+
+    /// eta_o, eta_e, kappa_o, kappa_e and optic_axis (differentiable in the JIT variants).
+    shim::Differentiable<Float> m_diff;
     rust::Box<bfr::Materials> m_material = bfr::new_materials();
     double m_ext_ior;
-    ScalarVector3f m_optic_axis;
     bool m_axis_in_world = false;
     std::string m_channel;                ///< the colour channel of a mono variant's render
     double m_wavelength = RgbWavelength;  ///< where the RGB and mono variants evaluate it

@@ -267,6 +267,11 @@ template <size_t Cap> struct ChunkBuffers {
     std::array<std::array<double, Cap * MaxChannels>, 3> in_x, out_x;
     std::array<std::array<double, Cap * MaxChannels>, 16> value;
 
+    /// Output columns of derivatives (tangents.h), sized on the first query that asks for
+    /// them: `columns` per lane, per channel for the weight.
+    std::array<std::vector<double>, 3> d_wo;
+    std::array<std::vector<double>, 16> d_value;
+
     /// Copies `c` for lanes [begin, end) into input column `k` (one value if `c` has one),
     /// applying `f` to each value.
     template <typename F = double (*)(double)>
@@ -324,6 +329,26 @@ template <size_t Cap> struct ChunkBuffers {
         return s;
     }
 };
+
+/// The core's derivative output view for `n` lanes of `channels` channels and the request
+/// `inputs` (`columns` columns); `polarized`: the whole Mueller matrix, else its (0, 0) entry.
+template <size_t Cap>
+bfr::Tangents tangent_columns(ChunkBuffers<Cap> &b, rust::Slice<const bfr::Tangent> inputs,
+                              size_t columns, size_t n, size_t channels, bool polarized) {
+    bfr::Tangents t{};
+    t.inputs = inputs;
+    for (size_t k = 0; k < 3; ++k) {
+        if (b.d_wo[k].size() < columns * Cap)
+            b.d_wo[k].resize(columns * Cap);
+        t.wo[k] = { b.d_wo[k].data(), columns * n };
+    }
+    for (size_t e = 0; e < (polarized ? 16 : 1); ++e) {
+        if (b.d_value[e].size() < columns * Cap * MaxChannels)
+            b.d_value[e].resize(columns * Cap * MaxChannels);
+        t.value[e] = { b.d_value[e].data(), columns * channels * n };
+    }
+    return t;
+}
 
 /** Buffers for one chunk: on the stack in the scalar variants; in the JIT ones, one set per
  * thread of Dr.Jit's pool, allocated on its first chunk and reused by every later one (a chunk

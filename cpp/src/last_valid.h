@@ -18,7 +18,9 @@ NAMESPACE_BEGIN(shim)
 /** The values an object exposes to `mi.traverse`, its own and its textures' (recursively),
  * saved so that they can be put back: the last valid state of a plugin, restored when an
  * update is rejected. Values of other types than those listed in `put_value` (none of the
- * plugins' or of Mitsuba's uniform, checkerboard and bitmap textures) are not saved. */
+ * plugins' or of Mitsuba's uniform, checkerboard and bitmap textures) are not saved. In the JIT
+ * variants a saved Float or Vector3f (a differentiable handle, a uniform texture's value) keeps
+ * its AD variable. */
 template <typename Float, typename Spectrum> class Snapshot final : public TraversalCallback {
 public:
     MI_IMPORT_CORE_TYPES()
@@ -36,6 +38,11 @@ public:
 
 protected:
     void put_value(std::string_view, void *value, uint32_t, const std::type_info &type) override {
+        if constexpr (dr::is_jit_v<Float>) {
+            // The differentiable handles of the JIT variants (differentiable.h).
+            if (save<Float>(value, type) || save<Vector3f>(value, type))
+                return;
+        }
         (void) (save<double>(value, type) || save<float>(value, type) ||
                 save<bool>(value, type) || save<int32_t>(value, type) ||
                 save<uint32_t>(value, type) || save<ScalarVector3f>(value, type) ||

@@ -25,19 +25,19 @@ Birefringent plate (:monosp:`thinbirefringent`)
      an isotropic glass; not together with ``material``), within [1e-3, 1e3] (as is every
      index). Floats only: an index that varies with wavelength is a ``material``. Exposed only
      when given (or when a plate's glass default stands for them).
-   - |exposed|
+   - |exposed|, |differentiable|
 
  * - kappa_o, kappa_e
    - |float|
    - Extinction coefficients added to the indices (``n + i kappa``, ``0 <= kappa <= 1e3``;
      dichroism when they differ). (Default: 0)
-   - |exposed|
+   - |exposed|, |differentiable|
 
  * - optic_axis
    - |vector|
    - The optic axis in the local shading frame (x = dp/du, z = normal), any non-zero length; at
      each point rotated about the normal by ``axis_angle``. (Default: ``[1, 0, 0]``)
-   - |exposed|
+   - |exposed|, |differentiable|
 
  * - ext_ior
    - |float| or |string|
@@ -57,7 +57,7 @@ Birefringent plate (:monosp:`thinbirefringent`)
      warning). A plate thinner than 0.01 um (a thickness in metres would give it), or a
      birefringent plate whose retardance is below 1 nm (a photoelastic plate's millimetres given
      as micrometres) loads with a warning. (Default: 1 um, said in a warning at load)
-   - |exposed|
+   - |exposed|, |differentiable|
 
  * - thickness_scale
    - |float|
@@ -72,7 +72,7 @@ Birefringent plate (:monosp:`thinbirefringent`)
      also :monosp:`thindielectric`'s default) made birefringent by this alone, and loading says
      so in a warning; give ``eta_o`` = ``eta_e`` = your glass's index to choose it. Exposed only
      when given. (Default: none)
-   - |exposed|
+   - |exposed|, |differentiable|
 
  * - birefringence_scale
    - |float|
@@ -85,14 +85,16 @@ Birefringent plate (:monosp:`thinbirefringent`)
      (from x towards y): the principal stress direction of a photoelastic plate. A uniform value
      that is a round angle in radians (0.785 = pi/4, 1.571 = pi/2, ...) loads with a warning.
      Exposed only when given. (Default: 0)
-   - |exposed|
+   - |exposed|, |differentiable|
 
  * - filter_bandwidth
    - |float|
    - Spectral variants: full width at half maximum (nm) of the Gaussian band around each sampled
      wavelength over which the plate is integrated in closed form; 0 (or below 1e-12 of the
      wavelength) is the exact plate at the wavelength (the default: a band never paid at equal
-     error in the scene benchmark); at most a quarter of the wavelength. (Default: 0)
+     error in the scene benchmark); at most a quarter of the wavelength. Gradients (llvm_ad
+     variants) need 0: the band's closed form has no derivatives yet (docs/gradients.md).
+     (Default: 0)
    - |exposed|
 
  * - channel
@@ -148,6 +150,7 @@ evaluated with ``eval_1`` at the hit point (use ``raw="true"`` for data bitmaps)
         'thickness': 30.0
 */
 #include "plugins.h"
+#include "differentiable.h"
 #include "last_valid.h"
 #include "scalar_texture.h"
 #include "signed_rgb.h"
@@ -181,14 +184,14 @@ public:
     ThinBirefringent(const Properties &props) : Base(props) {
         shim::refuse_foreign(props, Foreign, ClassName);
         shim::Defaults defaults;
-        m_params = shim::parse_material(props, ClassName, defaults,
-                                        props.has_property("birefringence"));
+        shim::MaterialParams material = shim::parse_material(props, ClassName, defaults,
+                                                             props.has_property("birefringence"));
         m_ext_ior = shim::parse_ior(props, "ext_ior", "air", ClassName);
         m_exit_ior = props.has_property("exit_ior")
                          ? shim::parse_ior(props, "exit_ior", "air", ClassName)
                          : m_ext_ior;
         shim::require_vector(props, "optic_axis", ClassName);
-        m_optic_axis = props.get<ScalarVector3f>("optic_axis", ScalarVector3f(1.f, 0.f, 0.f));
+        m_diff.set(material, props.get<ScalarVector3f>("optic_axis", ScalarVector3f(1.f, 0.f, 0.f)));
         m_thickness = shim::scalar_texture<Float, Spectrum>(props, "thickness", 1.0,
                                                             "micrometres", ClassName);
         m_thickness_scale = props.get<double>("thickness_scale", 1.0);
@@ -208,23 +211,20 @@ public:
         defaults.log(ClassName);
     }
 
+    /// eta_o, eta_e, kappa_o, kappa_e, optic_axis and the textures' values are differentiable
+    /// in the JIT variants (differentiable.h); the media, scales and band are not.
     void traverse(TraversalCallback *cb) override {
-        if (!m_params.named) {
-            cb->put("eta_o", m_params.eta_o, ParamFlags::NonDifferentiable);
-            cb->put("eta_e", m_params.eta_e, ParamFlags::NonDifferentiable);
-        }
-        cb->put("kappa_o", m_params.kappa_o, ParamFlags::NonDifferentiable);
-        cb->put("kappa_e", m_params.kappa_e, ParamFlags::NonDifferentiable);
+        m_diff.traverse(cb);
+        const ParamFlags textures = shim::texture_flags<Float>();
         cb->put("ext_ior", m_ext_ior, ParamFlags::NonDifferentiable);
         cb->put("exit_ior", m_exit_ior, ParamFlags::NonDifferentiable);
-        cb->put("optic_axis", m_optic_axis, ParamFlags::NonDifferentiable);
-        cb->put("thickness", m_thickness, ParamFlags::NonDifferentiable);
+        cb->put("thickness", m_thickness, textures);
         cb->put("thickness_scale", m_thickness_scale, ParamFlags::NonDifferentiable);
         if (m_birefringence)
-            cb->put("birefringence", m_birefringence, ParamFlags::NonDifferentiable);
+            cb->put("birefringence", m_birefringence, textures);
         cb->put("birefringence_scale", m_birefringence_scale, ParamFlags::NonDifferentiable);
         if (m_axis_angle)
-            cb->put("axis_angle", m_axis_angle, ParamFlags::NonDifferentiable);
+            cb->put("axis_angle", m_axis_angle, textures);
         cb->put("filter_bandwidth", m_filter_bandwidth, ParamFlags::NonDifferentiable);
     }
 
@@ -239,7 +239,8 @@ private:
     /// one core query (textures at their mean, 550 nm, the filter band), so that invalid input
     /// fails here, with the core's message.
     void rebuild() {
-        m_material = shim::make_material(m_params, ClassName);
+        auto [material, axis] = m_diff.updated();
+        m_material = shim::make_material(material, ClassName);
         m_band = bfr::band_spectrum(m_filter_bandwidth);
         if constexpr (is_spectral_v<Spectrum>)
             m_spectrum = bfr::band_spectrum(m_filter_bandwidth);
@@ -265,7 +266,8 @@ private:
             m_components.push_back((uint32_t) m_types[1] | sides | asym);
             m_flags = m_components[0] | m_components[1];
         }
-        check_at_load();
+        check_at_load(axis);
+        m_diff.commit(material, axis);
         warn_of_units();
     }
 
@@ -303,9 +305,9 @@ public:
     std::string to_string() const override {
         std::ostringstream oss;
         oss << "ThinBirefringent[" << std::endl
-            << "  " << m_params.to_string() << "," << std::endl
+            << "  " << m_diff.material.to_string() << "," << std::endl
             << "  ext_ior = " << m_ext_ior << ", exit_ior = " << m_exit_ior << "," << std::endl
-            << "  optic_axis = " << m_optic_axis << "," << std::endl
+            << "  optic_axis = " << m_diff.axis << "," << std::endl
             << "  thickness = " << string::indent(m_thickness) << " (um)," << std::endl
             << "  thickness_scale = " << m_thickness_scale << "," << std::endl;
         if (m_birefringence)
@@ -334,9 +336,9 @@ private:
         return { components, !is_polarized_v<Spectrum>, m_absorbing_exit };
     }
 
-    /// One core query at normal incidence with the textures at their mean and the filter band
-    /// at 550 nm; throws its message.
-    void check_at_load() const {
+    /// One core query at normal incidence with the textures at their mean, the filter band at
+    /// 550 nm and the optic axis `optic_axis`; throws its message.
+    void check_at_load(const ScalarVector3f &optic_axis) const {
         shim::ChunkBuffers<1> b;
         const uint8_t one = 1;
         const uint32_t material = 0;
@@ -354,7 +356,7 @@ private:
         lanes.wavelengths_nm = { &wave, 1 };
         lanes.ext_ior = b.constant(ExtIor, m_ext_ior).slice();
         lanes.exit_ior = b.constant(ExitIor, m_exit_ior).slice();
-        lanes.optic_axis = axis(b);
+        lanes.optic_axis = axis(b, optic_axis);
         double angle = m_axis_angle ? shim::scalar(m_axis_angle->mean()) : 0.0;
         lanes.axis_angle_deg = b.constant(AxisAngle, angle).slice();
         double thickness = thickness_nm(shim::scalar(m_thickness->mean()));
@@ -397,13 +399,21 @@ private:
         shim::require_evaluated_mode<Float>(ClassName);
         shim::HostInputs<Float> in;
         const shim::PathColumns path = shim::add_path_inputs<Float, Spectrum>(in, si, sample1, active);
-        size_t k_thick = in.add(m_thickness->eval_1(si, active));
-        size_t k_biref = m_birefringence ? in.add(m_birefringence->eval_1(si, active)) : 0;
-        size_t k_angle = m_axis_angle ? in.add(m_axis_angle->eval_1(si, active)) : 0;
+        Float thickness = m_thickness->eval_1(si, active);
+        Float birefringence = m_birefringence ? m_birefringence->eval_1(si, active) : Float(0.f);
+        Float angle_deg = m_axis_angle ? m_axis_angle->eval_1(si, active) : Float(0.f);
+        size_t k_thick = in.add(thickness);
+        size_t k_biref = m_birefringence ? in.add(birefringence) : 0;
+        size_t k_angle = m_axis_angle ? in.add(angle_deg) : 0;
         const size_t waves = path.waves;
         Answers answers;
         size_t n = in.width();
-        answers.allocate(n);
+        answers.allocate(n, tangent_inputs(si, thickness, birefringence, angle_deg));
+        const shim::TangentInputs<Float> &tangents = answers.tangents();
+        if (!tangents.empty())
+            shim::core_call(ClassName, [&] {
+                bfr::plate_tangents_available(*m_material, *m_spectrum, tangents.request());
+            });
         in.read();
 
         bool radiance = mode == TransportMode::Radiance;
@@ -422,7 +432,7 @@ private:
             lanes.wavelengths_nm = b.wavelength_columns(Wavelength0, waves);
             lanes.ext_ior = b.constant(ExtIor, m_ext_ior).slice();
             lanes.exit_ior = b.constant(ExitIor, m_exit_ior).slice();
-            lanes.optic_axis = axis(b);
+            lanes.optic_axis = axis(b, m_diff.axis);
             lanes.axis_angle_deg = m_axis_angle
                                        ? b.convert(AxisAngle, angle, begin, end).slice()
                                        : b.constant(AxisAngle, 0.0).slice();
@@ -434,7 +444,14 @@ private:
                                 [this](double x) { return m_birefringence_scale * x; }).slice()
                     : b.constant(Birefringence, 0.0).slice();
             bfr::Samples s = b.samples(lanes.count, channels, is_polarized_v<Spectrum>);
-            bfr::Status rc = bfr::sample_plate(*m_material, *m_spectrum, settings, lanes, s);
+            bfr::Status rc;
+            if (tangents.empty()) {
+                rc = bfr::sample_plate(*m_material, *m_spectrum, settings, lanes, s);
+            } else {
+                bfr::Tangents t = shim::tangent_columns(b, tangents.request(), tangents.columns(),
+                                                        lanes.count, channels, is_polarized_v<Spectrum>);
+                rc = bfr::sample_plate_tangents(*m_material, *m_spectrum, settings, lanes, t, s);
+            }
             for (size_t j = 0; j < lanes.count; ++j) {
                 size_t i = begin + j;
                 Vec3d wi(in.floats(path.wi[0]).at(i), in.floats(path.wi[1]).at(i),
@@ -443,6 +460,8 @@ private:
                 if (straight)
                     through = -wi;
                 answers.write(b, lanes.count, j, channels, wi, radiance, through, m_types, i);
+                if (!tangents.empty())
+                    answers.write_tangents(b, lanes.count, j, channels, i);
             }
             return rc == bfr::Status::Ok ? std::string() : shim::core_message(rc, s.message);
         });
@@ -451,19 +470,41 @@ private:
         return answers;
     }
 
-    /// The optic axis as given (the core rotates it by `axis_angle`).
-    template <size_t Cap>
-    std::array<rust::Slice<const double>, 3> axis(shim::ChunkBuffers<Cap> &b) const {
-        return { b.constant(AxisX, m_optic_axis.x()).slice(),
-                 b.constant(AxisY, m_optic_axis.y()).slice(),
-                 b.constant(AxisZ, m_optic_axis.z()).slice() };
+    /// The inputs of a query that carry gradients (the texture values at the hit, the
+    /// handles of the scalar parameters, si.wi), in the core's units.
+    shim::TangentInputs<Float> tangent_inputs(const SurfaceInteraction3f &si,
+                                              const Float &thickness, const Float &birefringence,
+                                              const Float &angle_deg) const {
+        shim::TangentInputs<Float> t;
+        t.add(bfr::Tangent::Thickness, thickness, thickness_nm(1.0));
+        if (m_birefringence)
+            t.add(bfr::Tangent::Birefringence, birefringence, m_birefringence_scale);
+        if (m_axis_angle)
+            t.add(bfr::Tangent::AxisAngle, angle_deg);
+        if (!m_diff.material.named) {
+            t.add(bfr::Tangent::EtaO, m_diff.eta_o());
+            t.add(bfr::Tangent::EtaE, m_diff.eta_e());
+        }
+        t.add(bfr::Tangent::KappaO, m_diff.kappa_o());
+        t.add(bfr::Tangent::KappaE, m_diff.kappa_e());
+        t.add(bfr::Tangent::OpticAxis, m_diff.optic_axis());
+        t.add(bfr::Tangent::Wi, si.wi);
+        return t;
     }
 
-    shim::MaterialParams m_params;
+    /// The optic axis `a` (the core rotates it by `axis_angle`).
+    template <size_t Cap>
+    static std::array<rust::Slice<const double>, 3> axis(shim::ChunkBuffers<Cap> &b,
+                                                         const ScalarVector3f &a) {
+        return { b.constant(AxisX, a.x()).slice(), b.constant(AxisY, a.y()).slice(),
+                 b.constant(AxisZ, a.z()).slice() };
+    }
+
+    /// eta_o, eta_e, kappa_o, kappa_e and optic_axis (differentiable in the JIT variants).
+    shim::Differentiable<Float> m_diff;
     rust::Box<bfr::Materials> m_material = bfr::new_materials();
     rust::Box<bfr::PlateSpectrum> m_spectrum = bfr::exact_spectrum(), m_band = bfr::exact_spectrum();
     double m_ext_ior, m_exit_ior;
-    ScalarVector3f m_optic_axis;
     ref<Texture> m_thickness, m_birefringence, m_axis_angle;
     double m_thickness_scale, m_birefringence_scale, m_filter_bandwidth;
     std::string m_channel;  ///< the colour channel of a mono variant's render

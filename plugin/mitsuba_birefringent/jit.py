@@ -3,7 +3,10 @@
 The plugins compute their lobes in the package's native core, outside Dr.Jit, so they need the
 values of the lanes that hit them: real arrays, not the symbolic variables Dr.Jit records loops
 and virtual calls with by default. Both flags must be off; with either on, the plugins raise an
-error that names them. ``evaluated_mode()`` switches them off around a render::
+error that names them. Python integrators (Mitsuba's ``prb``, ``prb_basic``, ...) also record
+their ``if`` statements on arrays symbolically, which makes the calls inside symbolic again (and
+Dr.Jit 1.5.0 fails in ``prb`` with only loops and calls off), so conditionals are switched off
+too. ``evaluated_mode()`` switches all three off around a render::
 
     import mitsuba as mi
     import mitsuba_birefringent
@@ -28,13 +31,13 @@ from typing import Iterator
 
 import drjit as dr
 
-#: The Dr.Jit flags that must be off.
-FLAGS = (dr.JitFlag.SymbolicLoops, dr.JitFlag.SymbolicCalls)
+#: The Dr.Jit flags that must be off (conditionals for Python integrators such as ``prb``).
+FLAGS = (dr.JitFlag.SymbolicLoops, dr.JitFlag.SymbolicCalls, dr.JitFlag.SymbolicConditionals)
 
 
 @contextlib.contextmanager
 def evaluated_mode() -> Iterator[None]:
-    """Switches Dr.Jit's symbolic loops and calls off, and restores them on exit."""
+    """Switches Dr.Jit's symbolic loops, calls and conditionals off, and restores them on exit."""
     saved = [dr.flag(f) for f in FLAGS]
     try:
         for f in FLAGS:

@@ -63,6 +63,11 @@ impl Materials {
             .map_or_else(String::new, |(_, w)| w.clone())
     }
 
+    /// Every material of the table.
+    pub fn all(&self) -> impl Iterator<Item = &Material> {
+        self.0.iter().map(|(m, _)| m)
+    }
+
     /// See `bridge::Materials::plate_warning` (a thickness warning only for an index in the
     /// table and parameters the load check accepts; that check refuses the others).
     pub fn plate_warning(

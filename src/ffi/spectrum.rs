@@ -108,6 +108,28 @@ impl PlateSpectrum {
         }
     }
 
+    /// Succeeds if a plate query over this spectrum gives derivatives (`render::tangents`): the
+    /// exact plate at each wavelength does. The closed-form integrals over a band or over colour
+    /// channels do not yet; the error says what to use instead.
+    pub fn check_tangents(&self) -> Result<()> {
+        let instead = "render gradients in llvm_ad_spectral or llvm_ad_spectral_polarized with filter_bandwidth 0, where the plate is exact at each sampled wavelength";
+        match *self {
+            PlateSpectrum::Bands { fwhm_nm: 0.0 } => Ok(()),
+            PlateSpectrum::Bands { fwhm_nm } => Err(Error::new(
+                "filter_bandwidth",
+                format!("gradients of a plate averaged over a band ({fwhm_nm} nm) are not available yet: set filter_bandwidth to 0 ({instead})"),
+            )),
+            PlateSpectrum::Srgb => Err(Error::new(
+                "variant",
+                format!("gradients of a plate integrated over the sRGB channels (llvm_ad_rgb) are not available yet: {instead}"),
+            )),
+            PlateSpectrum::Channel(c) => Err(Error::new(
+                "variant",
+                format!("gradients of a plate integrated over the colour channel \"{}\" (llvm_ad_mono, llvm_ad_mono_polarized) are not available yet: {instead}", c.name()),
+            )),
+        }
+    }
+
     /// The core's spectrum for one lane with wavelengths `lambda[..count]`, and which of its
     /// channels are the query's (`None`: all).
     pub fn lane(&self, lambda: [f64; MAX_BANDS], count: usize) -> (Spectrum, Option<usize>) {

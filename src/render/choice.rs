@@ -3,12 +3,16 @@
 //! traces along one path, or colour channels), so that every channel's expectation is the sum
 //! of its lobes.
 //!
-//! A slot is chosen with probability proportional to the magnitude of its unpolarised
-//! throughput (`|M00|`) summed over the channels (a signed sRGB channel is negative where the
+//! A slot is chosen with probability proportional to the magnitude of its unpolarised power
+//! fraction (`|M00|` of the physical transfer, without the radiance factor of Radiance mode:
+//! [`PathLobe::power`]) summed over the channels (a signed sRGB channel is negative where the
 //! plate's colour lies outside the gamut: a lobe negative in every channel of the query, as in
-//! a one-channel render, must still be chosen for the expectation to hold); the ray follows the slot's
-//! direction in the first channel that has it (the hero wavelength), and every channel carries
-//! its own lobe of that slot divided by the probability. With dispersion the other wavelengths
+//! a one-channel render, must still be chosen for the expectation to hold). The probabilities
+//! are thus the same in both transport modes and, for a dielectric interface, those of
+//! Mitsuba's `dielectric` (its Fresnel `R` and `T`): with the probability detached, the
+//! gradient of an attached sample's weight is then the built-in's (`render::tangents`). The
+//! ray follows the slot's direction in the first channel that has it (the hero wavelength), and
+//! every channel carries its own lobe of that slot divided by the probability. With dispersion the other wavelengths
 //! are thus propagated along the hero's direction: their Fresnel, polarisation, o/e split and
 //! radiance factor are exact, their angular dispersion (~0.5 degrees over the visible for
 //! calcite) is neglected. A slot that is the only candidate is chosen with probability 1 whatever
@@ -16,6 +20,8 @@
 //! the lobe itself, the form `eval_null_transmission` needs).
 
 use crate::render::slots::Slots;
+#[cfg(doc)]
+use crate::render::PathLobe;
 
 /// The chosen slot.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -40,7 +46,7 @@ pub fn choose<const S: usize>(
     let weight: [Option<f64>; S] = std::array::from_fn(|slot| {
         let lobes = channels.iter().filter_map(|c| c[slot].as_ref());
         (enabled(slot) && lobes.clone().next().is_some())
-            .then(|| lobes.map(|l| l.weight.abs()).sum())
+            .then(|| lobes.map(|l| l.power.abs()).sum())
     });
     let chosen = |slot: usize, pdf: f64| Choice {
         slot,

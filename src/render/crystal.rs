@@ -232,9 +232,10 @@ fn path_lobe(
             component,
             l.direction,
             (l.stokes_x, arrival.stokes_x),
-            reversed(&l.mueller) * (arrival.ray_index / l.ray_index).powi(2),
+            reversed(&l.mueller),
             ratio,
-        ),
+        )
+        .with_radiance_factor((arrival.ray_index / l.ray_index).powi(2)),
     };
     Some((crystal_slot(incident, mode), lobe))
 }

@@ -75,5 +75,5 @@ fn lobe(
         Transport::Radiance => (wo, 1.0 / (n_ratio * n_ratio)),
     };
     let s = PlaneFrame::from_direction(towards).s;
-    PathLobe::new(component, wo, (s, s), m * scale, n_ratio)
+    PathLobe::new(component, wo, (s, s), m, n_ratio).with_radiance_factor(scale)
 }

@@ -12,8 +12,10 @@
 pub mod choice;
 pub mod crystal;
 pub mod isotropic;
+pub mod mitsuba_frames;
 pub mod plate;
 pub mod slots;
+pub mod tangents;
 
 use nalgebra::{Matrix4, Vector3};
 
@@ -40,14 +42,18 @@ pub struct PathLobe {
     /// Physical Mueller matrix (Mitsuba's convention); in Radiance mode scaled by
     /// `(n_wi / n_wo)²` (radiance across an index step, ray indices of eq. S14).
     pub mueller: Matrix4<f64>,
-    /// `mueller[(0,0)]`, the unpolarised throughput used to pick a lobe.
+    /// `mueller[(0,0)]`, the unpolarised throughput.
     pub weight: f64,
+    /// The unpolarised power fraction of the physical transfer (`weight` without the radiance
+    /// factor of Radiance mode; the same in both modes): what a lobe is chosen by
+    /// ([`choice`]), as Mitsuba's own `dielectric` chooses by its Fresnel reflectance.
+    pub power: f64,
     /// Mitsuba's `bs.eta`: ray index on the `wo` side over the `wi` side.
     pub eta: f64,
 }
 
 impl PathLobe {
-    /// A lobe whose weight is its Mueller matrix's `M00`; `stokes_x` = (in, out).
+    /// A lobe whose weight and power are its Mueller matrix's `M00`; `stokes_x` = (in, out).
     pub fn new(
         component: usize,
         wo: Vector3<f64>,
@@ -62,7 +68,18 @@ impl PathLobe {
             out_stokes_x,
             mueller,
             weight: mueller[(0, 0)],
+            power: mueller[(0, 0)],
             eta,
+        }
+    }
+
+    /// The lobe with its Mueller matrix and weight multiplied by the radiance factor `factor`
+    /// (Radiance mode, `(n_wi / n_wo)²`), its power fraction unchanged.
+    pub fn with_radiance_factor(self, factor: f64) -> Self {
+        PathLobe {
+            mueller: self.mueller * factor,
+            weight: self.weight * factor,
+            ..self
         }
     }
 }

@@ -252,7 +252,7 @@ fn lobes_of_plate(
         for (c, m) in ms.iter().enumerate() {
             let m = if component == 0 { m.r } else { m.t };
             let Some(m) = m else { continue };
-            let mut mueller = if reverse { reversed(&m) } else { m } * scale;
+            let mut mueller = if reverse { reversed(&m) } else { m };
             // A band-averaged coherency of a plate that passes (almost) nothing can give M00 a
             // rounding-level negative (seen: -2e-22); under a non-negative weight the
             // unpolarised throughput is >= 0. (A signed sRGB channel keeps its sign.)
@@ -263,7 +263,9 @@ fn lobes_of_plate(
                 Transport::Radiance => n_in / n_out,
                 Transport::Importance => n_out / n_in,
             };
-            out[c][component] = Some(PathLobe::new(component, wo, (s, s), mueller, eta));
+            out[c][component] = Some(
+                PathLobe::new(component, wo, (s, s), mueller, eta).with_radiance_factor(scale),
+            );
         }
     }
     Ok(out)

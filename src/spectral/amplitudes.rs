@@ -258,8 +258,11 @@ pub fn least_attenuation(plate: &Plate, amplitudes: &Amplitudes) -> Option<[f64;
     };
     // Lobatto order: finest node 0 is t = 1 (the short-wave end), the last t = −1.
     let points = [(k0, centre), (k0 + a, ends[0]), (k0 - a, ends[1])];
-    // (An absorbing layer's modes are lossy at every wavelength: only a clear layer changes.)
-    let evanescent = |q: &[C64; 4]| q.map(|x| x.im != 0.0);
+    // A wave is evanescent where it decays faster than it oscillates (`Im q > |Re q|`): a clear
+    // layer's propagating waves have `Im q = 0`, and a barely absorbing layer's (kappa 1e-272)
+    // a tiny `Im q`, so a wave turning evanescent inside the band is seen in both (comparing
+    // `Im q` with 0 missed it in the absorbing layer, whose round trip then diverged).
+    let evanescent = |q: &[C64; 4]| q.map(|x| x.im > x.re.abs());
     if points
         .iter()
         .any(|(_, q)| evanescent(q) != evanescent(&centre))
@@ -290,6 +293,28 @@ mod tests {
             exit: C64::new(1.5, 0.0),
             axis: Vector3::new(0.3, -0.5, 0.7).normalize(),
             thickness_nm: 1e4,
+        }
+    }
+
+    /// A wave that turns evanescent inside the band is seen whether the layer is clear or barely
+    /// absorbing (calcite with kappa_e = 4e-272 under BK7 at 82 degrees, where the e wave turns
+    /// evanescent: the plugin fuzzer's case; the tiny kappa had hidden it, and the channel
+    /// integration's round trip diverged).
+    #[test]
+    fn a_wave_turning_evanescent_is_seen_in_a_barely_absorbing_layer() {
+        let frame = PlaneFrame::from_azimuth(266.127f64.to_radians());
+        let beta = C64::new(1.5046 * 81.8949f64.to_radians().sin(), 0.0);
+        for kappa_e in [0.0, 3.9394976309445163e-272, 1e-12] {
+            let p = Plate {
+                material: Material::named("calcite", 0.0, kappa_e).unwrap(),
+                birefringence: 0.0,
+                ext: C64::new(1.5046, 0.0),
+                exit: C64::new(1.5046, 0.0),
+                axis: Vector3::new(1.0, 0.0, 0.0),
+                thickness_nm: 1e3,
+            };
+            let amp = Amplitudes::new(&p, &frame, beta).unwrap();
+            assert!(least_attenuation(&p, &amp).is_none(), "kappa_e {kappa_e}");
         }
     }
 

@@ -94,6 +94,9 @@ def source_names(path: pathlib.Path) -> tuple[set[str], set[str]]:
             body = common[common.index(definition):]
             names |= set(re.findall(read, body[:body.index("\n}\n")]))
     exposed = set(re.findall(r'cb->put\("(\w+)"', source))
+    # The parameters differentiable.h exposes (their handles in the JIT variants).
+    if "m_diff.traverse(cb)" in source:
+        exposed |= set(re.findall(r'cb->put\("(\w+)"', (path.parent / "differentiable.h").read_text()))
     return names, exposed
 
 
