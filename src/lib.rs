@@ -16,6 +16,7 @@ pub mod params;
 pub mod plate;
 pub mod render;
 pub mod spectral;
+pub mod stack;
 
 pub use error::{Error, ErrorKind, Result};
 pub use num_complex::Complex64 as C64;

@@ -14,6 +14,8 @@ pub mod crystal;
 pub mod isotropic;
 pub mod plate;
 pub mod slots;
+pub mod stack;
+pub mod thin;
 
 use nalgebra::{Matrix4, Vector3};
 
