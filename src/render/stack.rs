@@ -123,7 +123,12 @@ impl Thin for StackQuery {
                     if is_exact_band(fwhm_nm, wavelength_nm) {
                         model.at(wavelength_nm, want, self.output)
                     } else {
-                        model.band(&narrow_band(wavelength_nm, fwhm_nm), want, self.output)
+                        model.band(
+                            &narrow_band(wavelength_nm, fwhm_nm),
+                            want,
+                            self.output,
+                            Accuracy::Perceptual,
+                        )
                     }
                 })
                 .collect(),

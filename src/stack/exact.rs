@@ -25,7 +25,8 @@ use crate::cmath;
 use crate::error::{Error, Result};
 use crate::optics::frame::PlaneFrame;
 use crate::optics::interface::Interface;
-use crate::optics::modes::{modes, normal_components};
+use crate::optics::medium::Uniaxial;
+use crate::optics::modes::{modes, normal_components, Mode};
 use crate::optics::mueller;
 use crate::plate::slab::{inverse, phase_factors, scale, SlabJones, SlabMueller, Want};
 use crate::stack::Stack;
@@ -98,12 +99,38 @@ pub fn layer_q(
 }
 
 impl StackBlocks {
-    /// The stack at `lambda_nm` for incidence parameter `beta` in the plane of `frame`.
+    /// The stack at `lambda_nm` for incidence parameter `beta` in the plane of `frame`: each
+    /// interface solved where it lies (an [`Interface`] is large: moving it costs about as much
+    /// as solving it) and reduced to its blocks.
     pub fn new(stack: &Stack, lambda_nm: f64, frame: &PlaneFrame, beta: C64) -> Result<Self> {
-        Ok(Self::from_interfaces(
-            stack,
-            &interfaces(stack, lambda_nm, frame, beta)?,
-        ))
+        let n = stack.layers.len();
+        let mut out = StackBlocks {
+            interfaces: Vec::with_capacity(n + 1),
+            q: Vec::with_capacity(n),
+            thickness_nm: stack.layers.iter().map(|l| l.thickness_nm).collect(),
+            flux: 0.0,
+        };
+        let top = modes(&Uniaxial::isotropic(stack.ext)?, beta);
+        let mut iface = Interface::unsolved(top, top);
+        for j in 0..=n {
+            let below = match stack.layers.get(j) {
+                Some(l) => modes(&l.medium(lambda_nm, frame)?, beta),
+                None => modes(&Uniaxial::isotropic(stack.exit)?, beta),
+            };
+            iface.upper = iface.lower;
+            iface.lower = below;
+            if j == 0 {
+                iface.upper = top;
+            }
+            iface.solve_in_place()?;
+            out.interfaces.push(blocks_of(&iface));
+            if j < n {
+                let m = &iface.lower;
+                out.q.push([m.down[0].q, m.down[1].q, m.up[0].q, m.up[1].q]);
+            }
+        }
+        out.flux = flux_ratio(&top.down[0], &iface.lower.down[0]);
+        Ok(out)
     }
 
     /// The blocks of solved `interfaces` (as [`interfaces`] gives them) of `stack`.
@@ -115,22 +142,14 @@ impl StackBlocks {
                 [m.down[0].q, m.down[1].q, m.up[0].q, m.up[1].q]
             })
             .collect();
-        let (top, bottom) = (&interfaces[0], &interfaces[layers]);
-        let p_in = top.upper.down[0].flux.abs();
-        let out = &bottom.lower.down[0];
-        let flux = if p_in > 0.0 && !out.is_evanescent() {
-            out.flux.abs() / p_in
-        } else {
-            0.0
-        };
         StackBlocks {
-            interfaces: interfaces
-                .iter()
-                .map(|i| [i.r_above(), i.t_above(), i.r_below(), i.t_below()])
-                .collect(),
+            interfaces: interfaces.iter().map(blocks_of).collect(),
             q,
             thickness_nm: stack.layers.iter().map(|l| l.thickness_nm).collect(),
-            flux,
+            flux: flux_ratio(
+                &interfaces[0].upper.down[0],
+                &interfaces[layers].lower.down[0],
+            ),
         }
     }
 
@@ -205,6 +224,21 @@ impl StackBlocks {
             thickness_nm,
             flux: v[v.len() - 1].re,
         }
+    }
+}
+
+/// `[r↓, t↓, r↑, t↑]` of a solved interface.
+fn blocks_of(i: &Interface) -> InterfaceBlocks {
+    [i.r_above(), i.t_above(), i.r_below(), i.t_below()]
+}
+
+/// Flux factor `P_out / P_in` of the transmitted wave (eq. S19; 0 if it is evanescent).
+fn flux_ratio(incident: &Mode, transmitted: &Mode) -> f64 {
+    let p_in = incident.flux.abs();
+    if p_in > 0.0 && !transmitted.is_evanescent() {
+        transmitted.flux.abs() / p_in
+    } else {
+        0.0
     }
 }
 

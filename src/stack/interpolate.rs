@@ -29,6 +29,21 @@ pub struct Interpolant {
     hi: f64,
 }
 
+/// The series without its trailing coefficients as long as their magnitudes sum to at most
+/// `budget` (`|T_n| ≤ 1` on the interval: that sum bounds the change of every value).
+fn truncated(mut c: Vec<Vec<C64>>, budget: f64) -> Vec<Vec<C64>> {
+    let mut dropped = 0.0;
+    while c.len() > 1 {
+        let last = c[c.len() - 1].iter().map(|z| z.norm()).fold(0.0, f64::max);
+        if dropped + last > budget {
+            break;
+        }
+        dropped += last;
+        c.pop();
+    }
+    c
+}
+
 impl Interpolant {
     /// Interpolates `exact(k)` on `[lo, hi]` with [`NODES`], else [`MORE_NODES`] nodes;
     /// `Ok(None)` if both fail their check.
@@ -72,7 +87,7 @@ impl Interpolant {
             .map(|z| z.norm())
             .fold(0.0, f64::max);
         let f = Interpolant {
-            coefficients,
+            coefficients: truncated(coefficients, 0.1 * TOLERANCE * largest),
             lo,
             hi,
         };

@@ -139,9 +139,12 @@ impl Stack {
 }
 
 /// An error of layer `index` (0-based) under that layer's name: `layers[2].thickness_um`.
+/// (An error about the layer as a whole, with an empty parameter, becomes `layers[2]`.)
 pub fn in_layer(index: usize, e: Error) -> Error {
-    Error {
-        parameter: format!("layers[{index}].{}", e.parameter),
-        ..e
-    }
+    let parameter = if e.parameter.is_empty() {
+        format!("layers[{index}]")
+    } else {
+        format!("layers[{index}].{}", e.parameter)
+    };
+    Error { parameter, ..e }
 }

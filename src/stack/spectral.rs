@@ -95,12 +95,19 @@ impl<'a> StackModel<'a> {
         Ok(Plan::new(&paths, &r, reach, exact))
     }
 
-    /// Over the Gaussian band `g` (module docs).
-    pub fn band(&self, g: &Gaussian, want: Want, output: Output) -> Result<SlabMueller> {
+    /// Over the Gaussian band `g` (module docs): the partially coherent model at
+    /// [`Accuracy::Perceptual`], the exact stack at [`Accuracy::Exact`].
+    pub fn band(
+        &self,
+        g: &Gaussian,
+        want: Want,
+        output: Output,
+        accuracy: Accuracy,
+    ) -> Result<SlabMueller> {
         let plan = self.plan(
             &[g.mu, g.mu + 3.0 * g.sigma],
             reach_of_gaussian(1.0, g.sigma),
-            false,
+            accuracy == Accuracy::Exact,
         )?;
         let omega = fastest(&plan);
         let panels =
@@ -218,6 +225,51 @@ impl<'a> StackModel<'a> {
             t: want.transmission.then_some(t),
         }))
     }
+}
+
+/// Most stack evaluations of one [`quadrature`].
+pub const QUADRATURE_MAX: usize = 10_000_000;
+
+/// Dense trapezoid quadrature of the exact stack `∫ weight(λ) M(λ) dλ` over `[lo, hi]` nm with
+/// a step of at most `step_nm` (the calculator's reference, `"method": "quadrature"`).
+#[allow(clippy::too_many_arguments)]
+pub fn quadrature(
+    stack: &Stack,
+    frame: &PlaneFrame,
+    beta: C64,
+    weight: impl Fn(f64) -> f64,
+    (lo, hi): (f64, f64),
+    step_nm: f64,
+    want: Want,
+) -> Result<SlabMueller> {
+    let count = ((hi - lo) / step_nm).ceil().max(1.0);
+    if !(step_nm > 0.0) || count.is_nan() || count > QUADRATURE_MAX as f64 {
+        return Err(Error::new(
+            "step_nm",
+            format!(
+                "too small: {count:.3e} stack evaluations over [{lo}, {hi}] nm (at most \
+                 {QUADRATURE_MAX:.0e}; minutes of run time)"
+            ),
+        ));
+    }
+    let n = count as usize;
+    let h = (hi - lo) / n as f64;
+    let model = StackModel::new(stack, *frame, beta);
+    let (mut r, mut t) = (Matrix4::zeros(), Matrix4::zeros());
+    for j in 0..=n {
+        let lambda = lo + h * j as f64;
+        let w = weight(lambda) * if j == 0 || j == n { 0.5 * h } else { h };
+        if w == 0.0 {
+            continue;
+        }
+        let m = model.at(lambda, want, Output::Mueller)?;
+        r += m.r.unwrap_or_default() * w;
+        t += m.t.unwrap_or_default() * w;
+    }
+    Ok(SlabMueller {
+        r: want.reflection.then_some(r),
+        t: want.transmission.then_some(t),
+    })
 }
 
 /// The fastest oscillation (nm) of the plan whose amplitude `ρⁿ / (1 − ρ)²` after `n` round
