@@ -243,7 +243,7 @@ pub fn quadrature(
     want: Want,
 ) -> Result<SlabMueller> {
     let count = ((hi - lo) / step_nm).ceil().max(1.0);
-    if !(step_nm > 0.0) || count.is_nan() || count > QUADRATURE_MAX as f64 {
+    if step_nm.is_nan() || step_nm <= 0.0 || count.is_nan() || count > QUADRATURE_MAX as f64 {
         return Err(Error::new(
             "step_nm",
             format!(
