@@ -139,13 +139,15 @@ evaluated with ``eval_1`` at the hit point (use ``raw="true"`` for data bitmaps)
 */
 #include "plugins.h"
 #include "last_valid.h"
+#include "layer.h"
 #include "scalar_texture.h"
 #include "signed_rgb.h"
 
 NAMESPACE_BEGIN(mitsuba)
 
 template <typename Float, typename Spectrum>
-class ThinBirefringent final : public BSDF<Float, Spectrum> {
+class ThinBirefringent final : public BSDF<Float, Spectrum>,
+                               public shim::LayerSource<Float, Spectrum> {
 public:
     MI_IMPORT_BASE(BSDF, m_flags, m_components)
     MI_IMPORT_TYPES(Texture)
@@ -156,6 +158,9 @@ public:
     static constexpr double DefaultFilterBandwidth = 0.0;
 
     ThinBirefringent(const Properties &props) : Base(props) {
+        for (const char *name : { "ext_ior", "exit_ior", "filter_bandwidth", "channel", "absorbing_exit" })
+            if (props.has_property(name))
+                m_surroundings.push_back(name);
         m_params = shim::parse_material(props, ClassName);
         m_ext_ior = shim::parse_ior(props, "ext_ior", "air", ClassName);
         m_exit_ior = props.has_property("exit_ior")
@@ -185,8 +190,10 @@ public:
         }
         cb->put("kappa_o", m_params.kappa_o, ParamFlags::NonDifferentiable);
         cb->put("kappa_e", m_params.kappa_e, ParamFlags::NonDifferentiable);
-        cb->put("ext_ior", m_ext_ior, ParamFlags::NonDifferentiable);
-        cb->put("exit_ior", m_exit_ior, ParamFlags::NonDifferentiable);
+        if (!m_nested) {
+            cb->put("ext_ior", m_ext_ior, ParamFlags::NonDifferentiable);
+            cb->put("exit_ior", m_exit_ior, ParamFlags::NonDifferentiable);
+        }
         cb->put("optic_axis", m_optic_axis, ParamFlags::NonDifferentiable);
         cb->put("thickness", m_thickness, ParamFlags::NonDifferentiable);
         cb->put("thickness_scale", m_thickness_scale, ParamFlags::NonDifferentiable);
@@ -195,7 +202,8 @@ public:
         cb->put("birefringence_scale", m_birefringence_scale, ParamFlags::NonDifferentiable);
         if (m_axis_angle)
             cb->put("axis_angle", m_axis_angle, ParamFlags::NonDifferentiable);
-        cb->put("filter_bandwidth", m_filter_bandwidth, ParamFlags::NonDifferentiable);
+        if (!m_nested)
+            cb->put("filter_bandwidth", m_filter_bandwidth, ParamFlags::NonDifferentiable);
     }
 
     /// Applies changed parameters; a rejected update leaves the last valid state in force
@@ -267,6 +275,22 @@ public:
         if (!m_null || shim::none_active(active))
             return dr::zeros<Spectrum>();
         return query(si, TransportMode::Radiance, 2u, Float(0.5f), active, true).spectrum();
+    }
+
+    void nest() override { m_nested = true; }
+
+    /// The plate as a layer of a stack (birefringentstack).
+    shim::PlateLayer<Float, Spectrum> layer() const override {
+        shim::PlateLayer<Float, Spectrum> l;
+        l.material = &m_params;
+        l.optic_axis = m_optic_axis;
+        l.thickness = m_thickness.get();
+        l.thickness_scale = m_thickness_scale;
+        l.birefringence = m_birefringence.get();
+        l.birefringence_scale = m_birefringence_scale;
+        l.axis_angle = m_axis_angle.get();
+        l.surroundings = &m_surroundings;
+        return l;
     }
 
     std::string to_string() const override {
@@ -420,6 +444,8 @@ private:
     ref<Texture> m_thickness, m_birefringence, m_axis_angle;
     double m_thickness_scale, m_birefringence_scale, m_filter_bandwidth;
     std::string m_channel;  ///< the colour channel of a mono variant's render
+    std::vector<std::string> m_surroundings;  ///< see shim::PlateLayer::surroundings
+    bool m_nested = false;  ///< a stack's layer (shim::LayerSource::nest)
     bool m_null = true, m_absorbing_exit = false;
     BSDFFlags m_types[(size_t) bfr::Bounds::PlateComponents];
     mutable std::atomic<bool> m_warned { false };

@@ -27,6 +27,7 @@
 
 use crate::error::Result;
 use crate::optics::frame::PlaneFrame;
+use crate::spectral::shared::TOLERANCE;
 use crate::spectral::weights::{gaussians, WeightSet};
 use crate::stack::coherence::Coherence;
 use crate::stack::exact::{interfaces, layer_q};
@@ -38,20 +39,14 @@ use std::f64::consts::TAU;
 /// threshold of the fringe tables, [`crate::spectral::fringe::NEGLIGIBLE`]).
 pub const NEGLIGIBLE: f64 = 1e-7;
 
-/// The reach (nm of group path) of a weight set: the largest `G` at which some Gaussian of it
-/// keeps `|a| e^{−σ²G²/2} > NEGLIGIBLE`.
-pub fn reach_of_set(set: WeightSet) -> f64 {
-    (0..3)
-        .flat_map(|c| gaussians(set, c).iter())
-        .filter(|g| g.amplitude.abs() > NEGLIGIBLE)
-        .map(|g| reach_of_gaussian(g.amplitude.abs(), g.sigma))
-        .fold(0.0, f64::max)
-}
-
 /// The reach of one Gaussian of mass `a` and width `sigma` (rad/nm).
 pub fn reach_of_gaussian(a: f64, sigma: f64) -> f64 {
     (2.0 * (a / NEGLIGIBLE).ln()).sqrt() / sigma
 }
+
+/// Largest visibility of a round trip [`Plan::thicken`] sums incoherently: its orders' cross
+/// terms, at most this fraction of the light they carry, are dropped.
+pub const THICKEN: f64 = 1e-3;
 
 /// Group paths of one layer (nm), see the module docs.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -153,15 +148,87 @@ pub fn reflectances(
         .collect())
 }
 
-impl Plan {
-    /// The plan for a weight of reach `reach` (nm), from the layers' group paths `paths` and the
-    /// interfaces' reflectances `reflectance`; `exact`: every layer coherent (the exact stack).
-    pub fn new(paths: &[LayerPaths], reflectance: &[f64], reach: f64, exact: bool) -> Self {
-        let n = paths.len();
-        let thick: Vec<bool> = paths
+/// What a spectral weight sees of a fringe: its reach and its visibility `V(G)` (the largest,
+/// over its channels, of `Σ_j |a_j| e^{−σ_j² G²/2}`).
+#[derive(Clone, Debug)]
+pub struct Weight {
+    /// `(|a_j|, σ_j)` of every Gaussian of every channel, per channel.
+    channels: Vec<Vec<(f64, f64)>>,
+}
+
+impl Weight {
+    /// The three channels of a weight set.
+    pub fn of_set(set: WeightSet) -> Self {
+        Weight {
+            channels: (0..3)
+                .map(|c| {
+                    gaussians(set, c)
+                        .iter()
+                        .map(|g| (g.amplitude.abs(), g.sigma))
+                        .collect()
+                })
+                .collect(),
+        }
+    }
+
+    /// One Gaussian band of unit mass and width `sigma` (rad/nm).
+    pub fn of_band(sigma: f64) -> Self {
+        Weight {
+            channels: vec![vec![(1.0, sigma)]],
+        }
+    }
+
+    /// The visibility of a fringe of constant amplitude and group path `g` (nm).
+    pub fn visibility(&self, g: f64) -> f64 {
+        self.channels
             .iter()
-            .map(|p| !exact && p.round_trip > reach)
+            .map(|c| {
+                c.iter()
+                    .map(|&(a, s)| a * (-0.5 * (s * g).powi(2)).exp())
+                    .sum::<f64>()
+            })
+            .fold(0.0, f64::max)
+    }
+
+    /// The reach (nm): beyond it every Gaussian is below [`NEGLIGIBLE`].
+    pub fn reach(&self) -> f64 {
+        self.channels
+            .iter()
+            .flatten()
+            .filter(|(a, _)| *a > NEGLIGIBLE)
+            .map(|&(a, s)| reach_of_gaussian(a, s))
+            .fold(0.0, f64::max)
+    }
+}
+
+impl Plan {
+    /// The plan for `weight`, from the layers' group paths `paths` and the interfaces'
+    /// reflectances `reflectance`; `exact`: every layer coherent (the exact stack). A layer is
+    /// thick when the strongest round trip across it, `r_i r_l` over the interfaces `i` above
+    /// and `l` below it, times the visibility of its own (shortest) round trip is at most
+    /// [`TOLERANCE`]: the interference it drops is invisible to that tolerance.
+    pub fn new(paths: &[LayerPaths], reflectance: &[f64], weight: &Weight, exact: bool) -> Self {
+        let n = paths.len();
+        let thick = (0..n)
+            .map(|j| {
+                let across = (0..=j)
+                    .flat_map(|i| (j + 1..=n).map(move |l| (i, l)))
+                    .map(|(i, l)| (reflectance[i] * reflectance[l]).sqrt())
+                    .fold(0.0, f64::max);
+                !exact && across * weight.visibility(paths[j].round_trip) <= TOLERANCE
+            })
             .collect();
+        Self::with_thick(paths, reflectance, weight.reach(), thick)
+    }
+
+    /// The plan with the layers `thick` thick (module docs; `reach` decides the kept modes).
+    pub fn with_thick(
+        paths: &[LayerPaths],
+        reflectance: &[f64],
+        reach: f64,
+        thick: Vec<bool>,
+    ) -> Self {
+        let n = paths.len();
         let keep_modes = kept_modes(paths, &thick, reach);
         let mut omega_b = 0.0;
         let mut per_trip = 0.0;
@@ -191,6 +258,28 @@ impl Plan {
             omega_1: 2.0 * per_trip,
             rho,
         }
+    }
+
+    /// The same plan with its thin layer of the longest round trip made thick, if the
+    /// visibility of that round trip under `weight` is at most [`THICKEN`] (else `None`): for a
+    /// spectrum whose coherent orders are too many for any rule (reflectances near 1 at
+    /// grazing incidence), orders that barely interfere are summed incoherently.
+    pub fn thicken(
+        &self,
+        paths: &[LayerPaths],
+        reflectance: &[f64],
+        weight: &Weight,
+    ) -> Option<Self> {
+        let thick = &self.coherence.thick;
+        let j = (0..paths.len())
+            .filter(|&j| !thick[j])
+            .max_by(|&a, &b| paths[a].round_trip.total_cmp(&paths[b].round_trip))?;
+        if weight.visibility(paths[j].round_trip) > THICKEN {
+            return None;
+        }
+        let mut thick = thick.clone();
+        thick[j] = true;
+        Some(Self::with_thick(paths, reflectance, weight.reach(), thick))
     }
 }
 
@@ -232,16 +321,18 @@ mod tests {
     #[test]
     fn thick_layers_and_kept_modes() {
         let r = [0.04, 0.0, 0.04];
+        let w = Weight::of_set(WeightSet::XyzD65);
         let zero_order = [paths(9_500.0, 3e6), paths(9_400.0, 3e6)];
-        let p = Plan::new(&zero_order, &r, 7_000.0, false);
+        let p = Plan::new(&zero_order, &r, &w, false);
         assert_eq!(p.coherence.thick, vec![true, true]);
         assert_eq!(p.coherence.keep_modes, vec![true, true]);
         let lone = [paths(170_000.0, 3e6), paths(100.0, 3e3)];
-        let p = Plan::new(&lone, &r, 7_000.0, false);
+        assert!(w.reach() > 3e3 && w.reach() < 3e6);
+        let p = Plan::new(&lone, &r, &w, false);
         assert_eq!(p.coherence.thick, vec![true, false]);
         assert_eq!(p.coherence.keep_modes, vec![false, true]);
         assert!((p.omega_b - 100.0).abs() < 1e-9);
-        let exact = Plan::new(&lone, &r, 7_000.0, true);
+        let exact = Plan::new(&lone, &r, &w, true);
         assert!(exact.coherence.is_exact());
         // Reflections across a thick layer count as powers, within thin ones as amplitudes.
         assert!((p.rho - (0.04f64 * 0.04)).abs() < 1e-12);

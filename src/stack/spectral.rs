@@ -32,7 +32,7 @@ use crate::spectral::weights::{gaussians, WeightSet};
 use crate::stack::coherence::{self, Coherence, Prepared};
 use crate::stack::exact::{layer_q, StackBlocks};
 use crate::stack::interpolate::Interpolant;
-use crate::stack::plan::{layer_paths, reach_of_gaussian, reach_of_set, reflectances, Plan};
+use crate::stack::plan::{layer_paths, reflectances, LayerPaths, Plan, Weight};
 use crate::stack::Stack;
 use nalgebra::Matrix4;
 use num_complex::Complex64 as C64;
@@ -88,11 +88,19 @@ impl<'a> StackModel<'a> {
         Ok(output.keep(m))
     }
 
-    /// The plan for a weight of reach `reach`, the group paths taken at wavenumbers `ks`.
-    pub fn plan(&self, ks: &[f64], reach: f64, exact: bool) -> Result<Plan> {
-        let paths = layer_paths(self.stack, &self.frame, self.beta, ks)?;
-        let r = reflectances(self.stack, TAU / ks[0], &self.frame, self.beta)?;
-        Ok(Plan::new(&paths, &r, reach, exact))
+    /// The layers' group paths at wavenumbers `ks` and the interfaces' reflectances at the
+    /// first of them: what [`Plan`]s are made of.
+    pub fn paths(&self, ks: &[f64]) -> Result<(Vec<LayerPaths>, Vec<f64>)> {
+        Ok((
+            layer_paths(self.stack, &self.frame, self.beta, ks)?,
+            reflectances(self.stack, TAU / ks[0], &self.frame, self.beta)?,
+        ))
+    }
+
+    /// The plan for `weight`, the group paths taken at wavenumbers `ks`.
+    pub fn plan(&self, ks: &[f64], weight: &Weight, exact: bool) -> Result<Plan> {
+        let (paths, r) = self.paths(ks)?;
+        Ok(Plan::new(&paths, &r, weight, exact))
     }
 
     /// Over the Gaussian band `g` (module docs): the partially coherent model at
@@ -106,7 +114,7 @@ impl<'a> StackModel<'a> {
     ) -> Result<SlabMueller> {
         let plan = self.plan(
             &[g.mu, g.mu + 3.0 * g.sigma],
-            reach_of_gaussian(1.0, g.sigma),
+            &Weight::of_band(g.sigma),
             accuracy == Accuracy::Exact,
         )?;
         let omega = fastest(&plan);
@@ -137,9 +145,18 @@ impl<'a> StackModel<'a> {
             .fold(0.0, f64::max)
             .min(hi);
         let exact = accuracy == Accuracy::Exact;
-        let plan = self.plan(&[0.5 * (lo + hi), bulk], reach_of_set(set), exact)?;
-        let points = shared::points(set, plan.omega_1, plan.omega_b, plan.rho);
-        let points = match (points, exact) {
+        let weight = Weight::of_set(set);
+        let (paths, r) = self.paths(&[0.5 * (lo + hi), bulk])?;
+        let mut plan = Plan::new(&paths, &r, &weight, exact);
+        let points = |p: &Plan| shared::points(set, p.omega_1, p.omega_b, p.rho);
+        // Too many coherent orders for any rule: the longest round trips become incoherent.
+        while points(&plan).is_none() && !exact {
+            match plan.thicken(&paths, &r, &weight) {
+                Some(p) => plan = p,
+                None => break,
+            }
+        }
+        let points = match (points(&plan), exact) {
             (Some(p), _) => p,
             (None, false) => LADDER[LADDER.len() - 1],
             (None, true) => {
