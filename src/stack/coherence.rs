@@ -77,58 +77,73 @@ impl Coherence {
 /// Mueller blocks `[R, T, R', T']` of a segment (the order of [`crate::stack::exact::InterfaceBlocks`]).
 type MuellerBlocks = [Matrix4<f64>; 4];
 
-/// What does not change between wavenumbers when the interface blocks do not (a stack without
-/// dispersion): the Mueller blocks of segments that are a single interface.
+/// What does not change between wavenumbers: the thick layers from the bottom up with the
+/// first interface of the segment above each ([`Coherence::thick_from_bottom`]), and, when the
+/// interface blocks do not change either (a stack without dispersion), the Mueller blocks of
+/// segments that are a single interface.
 #[derive(Clone, Debug, Default)]
 pub struct Prepared {
-    /// Per thick layer (from the bottom up, as [`Coherence::thick_from_bottom`]), the blocks of
-    /// the segment above it if that is one interface.
+    /// `(thick layer, first interface of the segment above it)`, from the bottom up.
+    thick: Vec<(usize, usize)>,
+    /// Per thick layer, the blocks of the segment above it if that is one interface (and they
+    /// are fixed).
     above: Vec<Option<MuellerBlocks>>,
-    /// `(M(Γ), M(τ))` of the bottom segment if it is the exit interface alone.
+    /// `(M(Γ), M(τ))` of the bottom segment if it is the exit interface alone (and fixed).
     bottom: Option<(Matrix4<f64>, Matrix4<f64>)>,
 }
 
 impl Prepared {
-    /// The single-interface segments of `blocks` under `coherence`.
-    pub fn new(blocks: &StackBlocks, coherence: &Coherence) -> Self {
-        if coherence.is_exact() {
-            return Prepared::default();
-        }
+    /// The structure of `coherence`, without fixed blocks.
+    pub fn structure(coherence: &Coherence) -> Self {
         let thick = coherence.thick_from_bottom();
+        Prepared {
+            above: vec![None; thick.len()],
+            thick,
+            bottom: None,
+        }
+    }
+
+    /// The structure of `coherence` and the fixed single-interface segments of `blocks`.
+    pub fn new(blocks: &StackBlocks, coherence: &Coherence) -> Self {
+        let mut p = Self::structure(coherence);
         let n = blocks.layers();
-        let above = thick
+        let Some(&(lowest, _)) = p.thick.first() else {
+            return p;
+        };
+        p.above = p
+            .thick
             .iter()
             .map(|&(j, a)| (a == j).then(|| blocks.interfaces[j].map(|m| mueller::from_jones(&m))))
             .collect();
-        let bottom = (thick[0].0 == n - 1).then(|| {
+        p.bottom = (lowest == n - 1).then(|| {
             let last = &blocks.interfaces[n];
             (
                 mueller::from_jones(&last[R_DOWN]),
                 mueller::from_jones(&last[T_DOWN]),
             )
         });
-        Prepared { above, bottom }
+        p
     }
 }
 
 /// The Mueller matrices (Mitsuba's convention, s/p frames, power fractions) of the stack of
 /// `blocks` at `lambda_nm` under `coherence` (module docs). `prepared`: from
-/// [`Prepared::new`] of the same blocks, or `None`.
+/// [`Prepared::new`] of the same blocks, or [`Prepared::structure`] of `coherence`.
 pub fn mueller(
     blocks: &StackBlocks,
     coherence: &Coherence,
-    prepared: Option<&Prepared>,
+    prepared: &Prepared,
     lambda_nm: f64,
     want: Want,
 ) -> Result<SlabMueller> {
     if coherence.is_exact() {
         return blocks.mueller(lambda_nm, want);
     }
-    let thick = coherence.thick_from_bottom();
+    let thick = &prepared.thick;
     let n = blocks.layers();
     // The bottom segment (thin layers under the lowest thick layer) in amplitudes.
     let lowest = thick[0].0;
-    let (mut gamma, mut tau) = match prepared.and_then(|p| p.bottom) {
+    let (mut gamma, mut tau) = match prepared.bottom {
         Some(b) => b,
         None => {
             let (g, t) = from_above(blocks, lowest + 1, n, lambda_nm)?;
@@ -141,7 +156,7 @@ pub fn mueller(
         let (md, mu) = (diagonal(pd, keep), diagonal(pu, keep));
         let g = mu * gamma * md;
         let t = tau * md;
-        let seg = match prepared.and_then(|p| p.above.get(k).copied().flatten()) {
+        let seg = match prepared.above[k] {
             Some(s) => s,
             None => segment(blocks, a, j, lambda_nm)?.map(|m| mueller::from_jones(&m)),
         };

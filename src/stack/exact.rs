@@ -29,7 +29,7 @@ use crate::optics::medium::Uniaxial;
 use crate::optics::modes::{modes, normal_components, Mode};
 use crate::optics::mueller;
 use crate::plate::slab::{inverse, phase_factors, scale, SlabJones, SlabMueller, Want};
-use crate::stack::Stack;
+use crate::stack::{in_layer, Stack};
 use nalgebra::Matrix2;
 use num_complex::Complex64 as C64;
 
@@ -91,11 +91,23 @@ pub fn layer_q(
     frame: &PlaneFrame,
     beta: C64,
 ) -> Result<Vec<[C64; 4]>> {
-    stack
-        .layers
-        .iter()
-        .map(|l| Ok(normal_components(&l.medium(lambda_nm, frame)?, beta)))
-        .collect()
+    let mut q = vec![[C64::new(0.0, 0.0); 4]; stack.layers.len()];
+    layer_q_into(stack, lambda_nm, frame, beta, &mut q)?;
+    Ok(q)
+}
+
+/// [`layer_q`] into `q` (one entry per layer).
+pub fn layer_q_into(
+    stack: &Stack,
+    lambda_nm: f64,
+    frame: &PlaneFrame,
+    beta: C64,
+    q: &mut [[C64; 4]],
+) -> Result<()> {
+    for (j, (l, qj)) in stack.layers.iter().zip(q.iter_mut()).enumerate() {
+        *qj = normal_components(&l.medium(lambda_nm, frame).map_err(|e| in_layer(j, e))?, beta);
+    }
+    Ok(())
 }
 
 impl StackBlocks {
@@ -114,7 +126,7 @@ impl StackBlocks {
         let mut iface = Interface::unsolved(top, top);
         for j in 0..=n {
             let below = match stack.layers.get(j) {
-                Some(l) => modes(&l.medium(lambda_nm, frame)?, beta),
+                Some(l) => modes(&l.medium(lambda_nm, frame).map_err(|e| in_layer(j, e))?, beta),
                 None => modes(&Uniaxial::isotropic(stack.exit)?, beta),
             };
             iface.upper = iface.lower;
@@ -209,21 +221,16 @@ impl StackBlocks {
         v
     }
 
-    /// The inverse of [`StackBlocks::values`] with the layers' normal components `q`.
-    pub fn from_values(v: &[C64], q: Vec<[C64; 4]>, thickness_nm: Vec<f64>) -> Self {
-        let m = |i: usize| Matrix2::new(v[i], v[i + 1], v[i + 2], v[i + 3]);
-        let interfaces = (0..q.len() + 1)
-            .map(|j| {
-                let o = j * INTERFACE_VALUES;
-                [m(o), m(o + 4), m(o + 8), m(o + 12)]
-            })
-            .collect();
-        StackBlocks {
-            interfaces,
-            q,
-            thickness_nm,
-            flux: v[v.len() - 1].re,
+    /// Sets the interface blocks and the flux from `v` ([`StackBlocks::values`]' layout).
+    pub fn set_values(&mut self, v: &[C64]) {
+        for (j, blocks) in self.interfaces.iter_mut().enumerate() {
+            let o = j * INTERFACE_VALUES;
+            for (b, m) in blocks.iter_mut().enumerate() {
+                let i = o + 4 * b;
+                *m = Matrix2::new(v[i], v[i + 1], v[i + 2], v[i + 3]);
+            }
         }
+        self.flux = v[v.len() - 1].re;
     }
 }
 

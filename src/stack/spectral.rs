@@ -30,7 +30,7 @@ use crate::spectral::model::Accuracy;
 use crate::spectral::shared::{self, LADDER, TOLERANCE};
 use crate::spectral::weights::{gaussians, WeightSet};
 use crate::stack::coherence::{self, Coherence, Prepared};
-use crate::stack::exact::{layer_q, StackBlocks};
+use crate::stack::exact::{layer_q_into, StackBlocks};
 use crate::stack::interpolate::Interpolant;
 use crate::stack::plan::{layer_paths, reflectances, LayerPaths, Plan, Weight};
 use crate::stack::Stack;
@@ -209,7 +209,7 @@ impl<'a> StackModel<'a> {
             let prepared = Prepared::new(&blocks, coherence);
             for (k, w) in nodes {
                 add(
-                    &coherence::mueller(&blocks, coherence, Some(&prepared), TAU / k, want)?,
+                    &coherence::mueller(&blocks, coherence, &prepared, TAU / k, want)?,
                     w,
                 );
             }
@@ -221,18 +221,20 @@ impl<'a> StackModel<'a> {
             } else {
                 None
             };
-            let thickness: Vec<f64> = self.stack.layers.iter().map(|l| l.thickness_nm).collect();
+            let prepared = Prepared::structure(coherence);
+            let mut blocks = self.solve(centre)?;
+            let mut v = blocks.values();
             for (k, w) in nodes {
-                let blocks = match &interpolant {
-                    Some(f) => StackBlocks::from_values(
-                        &f.at(*k),
-                        layer_q(self.stack, TAU / k, &self.frame, self.beta)?,
-                        thickness.clone(),
-                    ),
-                    None => self.solve(*k)?,
-                };
+                match &interpolant {
+                    Some(f) => {
+                        f.at_into(*k, &mut v);
+                        blocks.set_values(&v);
+                        layer_q_into(self.stack, TAU / k, &self.frame, self.beta, &mut blocks.q)?;
+                    }
+                    None => blocks = self.solve(*k)?,
+                }
                 add(
-                    &coherence::mueller(&blocks, coherence, None, TAU / k, want)?,
+                    &coherence::mueller(&blocks, coherence, &prepared, TAU / k, want)?,
                     w,
                 );
             }
