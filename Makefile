@@ -2,10 +2,12 @@
 #
 #   make render   the main job: builds everything (make setup), then renders the default scene
 #                 (a photoelastic disk under diametral compression between crossed circular
-#                 polarisers: its isochromatic fringes) to out/photoelastic_disk.exr and .png,
-#                 and Figure 1 of the paper's supplemental to out/fig1.png and out/fig1.json
-#   make gallery  make setup, then renders every scene of scenes/ at gallery size into
-#                 out/gallery/ and the contact sheet scenes/gallery.png (several minutes)
+#                 polarisers: its isochromatic fringes) by colour channels (render_analytic,
+#                 the multijitter sampler) to out/photoelastic_disk.exr and .png, and Figure 1
+#                 of the paper's supplemental to out/fig1.png and out/fig1.json
+#   make gallery  make setup, then renders every scene of scenes/ at gallery size (multijitter
+#                 sampler) into out/gallery/ and the contact sheet scenes/gallery.png (several
+#                 minutes)
 #   make test     builds everything (make setup), then runs every test: cargo fmt --check, cargo
 #                 clippy (warnings are errors), cargo's tests, then pytest's, then make fuzz-ci
 #   make setup    cargo build --release, the virtualenv .venv/ from requirements.txt, Debian's
@@ -29,6 +31,10 @@
 #   make fuzz-ci  (part of test) the same, strict (FUZZ_STRICT=1: soft findings fail), for
 #                 FUZZ_CI_SECONDS per libFuzzer target (10) and PLUGIN_FUZZ_CI_SECONDS (20)
 #                 for the plugin fuzzer
+#   make mutants  (not part of test) mutation testing: each mutation of tests/mutants/mutants.toml
+#                 applied alone to a scratch copy in target/mutants/, rebuilt, and the tests that
+#                 claim to cover it run; prints which are killed and which survive, fails if one
+#                 survives or no longer applies (tools/mutants.py; MUTANTS=id,id runs only those)
 #   make bench    make setup, then the core benchmark on one core (taskset -c 0) and its plot:
 #                 bench/out/core.json, bench/out/core_error_vs_time.png (several minutes), then
 #                 make bench-scenes and make bench-jit
@@ -37,11 +43,16 @@
 #                 memory; bench/out/jit.json and bench/out/jit.png
 #   make bench-scenes  the scene benchmarks alone: the core's shortcuts (examples/bench_shortcuts.rs,
 #                 one core), error vs time per scene, overhead against Mitsuba's own plugins;
-#                 writes bench/results.json, bench/out/ (JSON, PNG plots) and README.md's
-#                 benchmark section (~4 min)
+#                 writes bench/results.json, bench/out/ (JSON, PNG plots), docs/benchmarks.md
+#                 and the summary of it in README.md (~4 min)
 #   make bench-overhead  the overhead table alone (ours against Mitsuba's own plugins, isotropic
-#                 and anisotropic scenes), merged into bench/results.json and README.md's
-#                 benchmark section; the other figures are kept
+#                 and anisotropic scenes), merged into bench/results.json, docs/benchmarks.md
+#                 and README.md's summary; the other figures are kept
+#   make bench-variants  what each variant costs with the plugins (render time against
+#                 scalar_spectral_polarized in alternating pairs, peak memory of a process per
+#                 variant: bench/variants.py) and the default render's noise per sampler and
+#                 time (bench/default_render.py); printed, and written to bench/out/variants.json
+#                 and default_render.json (25 and 75 min on 2 cores at load average 6-12)
 
 SHELL := bash
 .SHELLFLAGS := -euo pipefail -c
@@ -71,7 +82,7 @@ PLUGIN_BUILT := target/release/libmitsuba_birefringent.so
 # site-packages of .venv/ (evaluated when used: the venv may not exist yet when make starts)
 SITE = $(shell $(VPY) -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')
 
-.PHONY: help setup build venv llvm plugin plugin-lib render gallery test test-rust test-python fuzz fuzz-ci bench bench-scenes bench-overhead bench-jit fmt lint clean distclean
+.PHONY: help setup build venv llvm plugin plugin-lib render gallery test test-rust test-python mutants fuzz fuzz-ci bench bench-scenes bench-overhead bench-jit bench-variants fmt lint clean distclean
 
 help:
 	@sed -n '3,/^$$/s/^# \{0,1\}//p' $(firstword $(MAKEFILE_LIST))
@@ -143,7 +154,9 @@ plugin-lib:
 
 # The default scene (scenes/photoelastic_disk.py) rendered by colour channels
 # (mitsuba_birefringent.render_analytic: one llvm_ad_mono_polarized pass per sRGB channel, the
-# plate integrated over each in closed form, no colour noise), and Figure 1 of the supplemental
+# plate integrated over each in closed form, no colour noise; the multijitter sampler of
+# scenes/render.py, which stratifies each path's choice between the plate's reflection and
+# transmission: the brightness noise that remains), and Figure 1 of the supplemental
 # (Fresnel power ratios of an isotropic/uniaxial interface, computed by the calculator binary, a
 # few seconds). Always regenerated. RENDER_MODE=spectral renders the scene by spectral sampling
 # in scalar_spectral_polarized instead.
@@ -183,6 +196,15 @@ test-python: plugin
 	  echo "$(PYTESTS): no Python test files; nothing to run"; rc=0; \
 	fi; \
 	exit $$rc
+
+## ---- mutation testing ------------------------------------------------------------------
+
+# tools/mutants.py: the copy in target/mutants/ builds with its own target dir (incremental
+# between mutations and runs) and the wheels of .venv/ (SITE); its tests run with .venv/'s
+# interpreter and the copy's package and plugin library (not the editable install's).
+MUTANTS ?=
+mutants: venv llvm
+	$(VPY) tools/mutants.py $(if $(MUTANTS),--only $(MUTANTS))
 
 ## ---- fuzzing --------------------------------------------------------------------------
 
@@ -239,22 +261,30 @@ bench-jit: setup
 # render_analytic among the methods; render-time overhead against Mitsuba's
 # thindielectric/dielectric, isotropic and anisotropic scenes), which writes bench/results.json;
 # bench/equal_time.py (the channel render and spectral sampling at equal time:
-# bench/analytic_vs_spectral.png); then bench/readme.py regenerates README.md between
-# <!-- bench:begin --> and <!-- bench:end -->.
+# bench/analytic_vs_spectral.png); then bench/readme.py regenerates docs/benchmarks.md between
+# <!-- bench:begin --> and <!-- bench:end --> and README.md's summary of it.
 bench-scenes: setup
 	$(CARGO) build --release --example bench_shortcuts
 	@mkdir -p $(BENCH_OUT)
 	$(TASKSET) target/release/examples/bench_shortcuts --out $(BENCH_OUT)/shortcuts.json
 	$(VPY) bench/scenes.py --out $(BENCH_OUT) --results bench/results.json
 	$(VPY) bench/equal_time.py --out $(BENCH_OUT) --results bench/results.json
-	$(VPY) bench/readme.py bench/results.json README.md
+	$(VPY) bench/readme.py bench/results.json docs/benchmarks.md README.md
 
 # Part 2 of bench/scenes.py alone (render-time overhead against thindielectric/dielectric, the
 # isotropic and the anisotropic rows), merged into bench/results.json; then the README section.
 bench-overhead: setup
 	@mkdir -p $(BENCH_OUT)
 	$(VPY) bench/scenes.py --only overhead --out $(BENCH_OUT) --results bench/results.json
-	$(VPY) bench/readme.py bench/results.json README.md
+	$(VPY) bench/readme.py bench/results.json docs/benchmarks.md README.md
+
+# bench/variants.py (each variant's time and memory with the plugins, one process per
+# measurement, rounds interleaved) and bench/default_render.py (make render's remaining noise
+# per sampler and its time against spectral sampling): the figures README.md states.
+bench-variants: setup
+	@mkdir -p $(BENCH_OUT)
+	$(VPY) bench/variants.py --out $(BENCH_OUT)/variants.json
+	$(VPY) bench/default_render.py --out $(BENCH_OUT)/default_render.json
 
 ## ---- code quality ----------------------------------------------------------------------
 

@@ -1,26 +1,34 @@
 #!/usr/bin/env python3
-"""Regenerate the benchmark section of README.md from bench/results.json.
+"""Regenerate the benchmark page docs/benchmarks.md, and the summary of it in README.md, from
+bench/results.json.
 
-    .venv/bin/python bench/readme.py [RESULTS_JSON] [README]
+    .venv/bin/python bench/readme.py [RESULTS_JSON] [BENCHMARKS_MD] [README]
 
-Replaces everything between the lines ``<!-- bench:begin -->`` and ``<!-- bench:end -->`` of the
-README (both must be present, once each) with tables of the figures in the results file: the
-machine and date, the render-time overhead against Mitsuba's own plugins (each row labelled
-isotropic or anisotropic), the speed-up of the closed-form spectral integration (or band filter)
-at equal image error per scene, the channel render's (``render_analytic``) at equal error and the
-equal-time figure of bench/equal_time.py, each against its goal (``GOALS``: met or not met), and
-every measured speed ratio of each of the core's shortcuts. Nothing is measured or typed here:
-every number comes from the JSON that ``make
-bench`` wrote.
+In BENCHMARKS_MD (default docs/benchmarks.md) it replaces everything between the lines
+``<!-- bench:begin -->`` and ``<!-- bench:end -->`` (both must be present, once each) with tables
+of the figures in the results file: the machine and date, the render-time overhead against
+Mitsuba's own plugins (each row labelled isotropic or anisotropic), the speed-up of the
+closed-form spectral integration (or band filter) at equal image error per scene, the channel
+render's (``render_analytic``) at equal error and the equal-time figure of bench/equal_time.py,
+each against its goal (``GOALS``: met or not met), and every measured speed ratio of each of the
+core's shortcuts. In README (default README.md) it replaces what lies between
+``<!-- bench-summary:begin -->`` and ``<!-- bench-summary:end -->`` with a few lines of headline
+ratios (``summary``: the overhead's range per kind of row and variant, the channel render's
+ratio at equal error), which follow new rows of the tables by themselves. Nothing is measured
+or typed here: every number comes from the JSON that ``make bench`` wrote.
 """
 
 from __future__ import annotations
 
 import json
+import os
 import pathlib
 import sys
 
 BEGIN, END = "<!-- bench:begin -->", "<!-- bench:end -->"
+SUMMARY_BEGIN, SUMMARY_END = "<!-- bench-summary:begin -->", "<!-- bench-summary:end -->"
+#: Where the tables and the summary go, relative to the repository (the defaults of main).
+BENCHMARKS_MD, README_MD = "docs/benchmarks.md", "README.md"
 
 # The goals the figures are judged against (the project's requirements), in one place:
 # (comparison, bound).
@@ -90,7 +98,9 @@ def busy(m: dict) -> str:
     return ""
 
 
-def section(r: dict) -> str:
+def section(r: dict, base: str = "") -> str:
+    """The benchmark page's generated part; `base`: the path from the page to the repository's
+    root (links to files of the repository start with it)."""
     m = r["machine"]
     lines = [
         f"Measured by `make bench-scenes` (the last step of `make bench`) on {r['date']}: {m['cpu']}, "
@@ -123,7 +133,7 @@ def section(r: dict) -> str:
             goal = f"{goal_text(g)}: {verdict(g, d['ratio'])}"
         lines.append(f"| {scene} | {image(frames.get(scene))} | {label[d['method']]} | {d['spp']} | {d['error']:.3f} | "
                      f"{d['seconds']:.2f} | {d['exact_seconds_at_error']:.2f} | {d['ratio']:.3g}{flag} | {goal} |")
-    lines += channel_section(r)
+    lines += channel_section(r, base)
     lines += ["", "**Shortcuts** (speed of the full computation's time over the shortcut's, every case "
               "measured; below 1 the shortcut is slower there):", "",
               "| shortcut | case | speed ratio |", "| --- | --- | --- |"]
@@ -172,7 +182,7 @@ def overhead_table(o: dict) -> list[str]:
     return lines
 
 
-def channel_section(r: dict) -> list[str]:
+def channel_section(r: dict, base: str = "") -> list[str]:
     """The channel render's tables (results.json "channel_render") and the equal-time figure
     ("equal_time", written by bench/equal_time.py); nothing when the results lack them."""
     channel = r.get("channel_render")
@@ -227,7 +237,7 @@ def channel_section(r: dict) -> list[str]:
             cells = [f"{rows[n]['mean_de2000']:.2f} ({rows[n]['seconds']:.2f})" if n in rows else "—"
                      for n in spps]
             lines.append(f"| {scene} | {entries[0]['sampler']} | " + " | ".join(cells) + " |")
-    lines += equal_time_section(r.get("equal_time"))
+    lines += equal_time_section(r.get("equal_time"), base)
     return lines
 
 
@@ -247,7 +257,7 @@ def channel_goal(scene: str, e: dict) -> str:
     return f"{goal_text(g)}: {verdict(g, worst)}"
 
 
-def equal_time_section(t: dict | None) -> list[str]:
+def equal_time_section(t: dict | None, base: str = "") -> list[str]:
     """The figure of bench/equal_time.py and what each panel took."""
     if not t:
         return []
@@ -255,7 +265,8 @@ def equal_time_section(t: dict | None) -> list[str]:
     lines = ["", f"**At equal render time** (`bench/equal_time.py`): the channel render at {spp} spp and exact "
              "sampling given the time of the channel render with the scene's own (independent) sampler, "
              "against an exact reference (mean CIEDE2000 under each panel):", "",
-             f"![The channel render and exact spectral sampling at equal render time]({t['figure']})", ""]
+             f"![The channel render and exact spectral sampling at equal render time]({base}{t['figure']})",
+             ""]
     for scene, d in t["scenes"].items():
         w, h = d["frame"]["crop"][2:]
         panels = "; ".join(f"{p['label'].replace(chr(10), ' ')} {p['spp']} spp in {p['seconds']:.1f} s: "
@@ -291,18 +302,72 @@ def image(frame: dict | None) -> str:
     return f"{w}x{h}" if [w, h] == full else f"{w}x{h} crop of {full[0]}x{full[1]}"
 
 
+def span(values: list[float]) -> str:
+    """'1.62x', or '1.50-2.24x' for the range of several ratios."""
+    lo, hi = min(values), max(values)
+    return f"{lo:.3g}x" if f"{lo:.3g}" == f"{hi:.3g}" else f"{lo:.3g}-{hi:.3g}x"
+
+
+def summary(r: dict) -> str:
+    """The README's headline ratios: per kind of overhead row and plugin, the range of ours /
+    Mitsuba's in each variant; the channel render's ratio at equal error at CHANNEL_GOAL_SPP."""
+    o = r["overhead"]
+    variants = o["settings"]["variants"]
+    groups: dict[tuple[str, str], list[dict]] = {}
+    for row in o["rows"].values():
+        groups.setdefault((row["kind"], row["plugin"]), []).append(row)
+    m = o["measured"]
+    lines = [f"Render time of the plugins against Mitsuba's own (`thindielectric`, `dielectric`) in the "
+             f"same scene, ours / theirs (median of {o['settings']['repeats']} interleaved renders, "
+             f"measured on {m['date']}, load average {fmt_load(m.get('load_average_start'))} to "
+             f"{fmt_load(m.get('load_average_end'))} on {r['machine']['logical_cores']} cores):", ""]
+    for (kind, plugin), rows in groups.items():
+        cells = [f"{span([x['ratio'][v] for x in rows if v in x['ratio']])} in {v}" for v in variants
+                 if any(v in x["ratio"] for x in rows)]
+        lines.append(f"- {kind} `{plugin}` ({len(rows)} scene{'s' if len(rows) > 1 else ''}): "
+                     + ", ".join(cells))
+    channel = r.get("channel_render") or {}
+    by_sampler: dict[str, list[float]] = {}
+    for c in channel.values():
+        for entries in c["at_equal_error"].values():
+            for e in entries:
+                if e["spp"] == CHANNEL_GOAL_SPP:
+                    by_sampler.setdefault(e["sampler"], []).append(e["exact"]["ratio"])
+    if by_sampler:
+        cells = [f"{span(v)} with `{s}`" for s, v in by_sampler.items()]
+        lines += ["", f"`render_analytic` at {CHANNEL_GOAL_SPP} spp against spectral sampling in "
+                  "scalar_spectral_polarized at equal error (mean CIEDE2000), the time spectral sampling "
+                  f"needs over the channel render's, over {len(channel)} scenes: " + ", ".join(cells) + "."]
+    return "\n".join(lines)
+
+
+def replaced_between(path: pathlib.Path, begin: str, end: str, body: str) -> str | None:
+    """The text of `path` with what lies between the lines `begin` and `end` replaced by `body`;
+    None (and a message) if the file lacks them."""
+    text = path.read_text(encoding="utf-8")
+    if text.count(begin) != 1 or text.count(end) != 1 or text.index(begin) > text.index(end):
+        print(f"{path}: needs one '{begin}' line followed by one '{end}' line", file=sys.stderr)
+        return None
+    head, rest = text.split(begin, 1)
+    _, tail = rest.split(end, 1)
+    return f"{head}{begin}\n{body}\n{end}{tail}"
+
+
 def main() -> int:
     src = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else "bench/results.json")
-    readme = pathlib.Path(sys.argv[2] if len(sys.argv) > 2 else "README.md")
-    text = readme.read_text(encoding="utf-8")
-    if text.count(BEGIN) != 1 or text.count(END) != 1 or text.index(BEGIN) > text.index(END):
-        print(f"{readme}: needs one '{BEGIN}' line followed by one '{END}' line", file=sys.stderr)
+    page = pathlib.Path(sys.argv[2] if len(sys.argv) > 2 else BENCHMARKS_MD)
+    readme = pathlib.Path(sys.argv[3] if len(sys.argv) > 3 else README_MD)
+    results = json.loads(src.read_text(encoding="utf-8"))
+    # Links from the page to the repository's files (the figure) start from the page's folder.
+    root = pathlib.Path(__file__).resolve().parents[1]
+    base = os.path.relpath(root, page.resolve().parent).replace(os.sep, "/") + "/"
+    texts = {page: replaced_between(page, BEGIN, END, section(results, "" if base == "./" else base)),
+             readme: replaced_between(readme, SUMMARY_BEGIN, SUMMARY_END, summary(results))}
+    if None in texts.values():
         return 1
-    head, rest = text.split(BEGIN, 1)
-    _, tail = rest.split(END, 1)
-    body = section(json.loads(src.read_text(encoding="utf-8")))
-    readme.write_text(f"{head}{BEGIN}\n{body}\n{END}{tail}", encoding="utf-8")
-    print(f"{readme}: benchmark section regenerated from {src}")
+    for path, text in texts.items():
+        path.write_text(text, encoding="utf-8")
+    print(f"{page} and the summary in {readme} regenerated from {src}")
     return 0
 
 

@@ -631,6 +631,13 @@ def solids(mi, bsdf: dict) -> dict:
                      "to_world": T().translate([0.7, 0.3, 0.45]).rotate([0, 0, 1], 30).scale(0.42)}}
 
 
+def bouncing_sphere(mi, bsdf: dict) -> dict:
+    """One sphere (radius 0.8) resting on the floor in front of the camera, about half the frame:
+    most camera paths enter it, and light bounces inside it (``path`` with max_depth 8), so the
+    surface is queried several times per path (the crystal's cost at its most visible)."""
+    return {"sphere": {"type": "sphere", "center": [0.0, -1.2, 0.8], "radius": 0.8, "bsdf": bsdf}}
+
+
 def plate(**params) -> dict:
     return {"type": "thinbirefringent", "ext_ior": 1.0, **params}
 
@@ -667,6 +674,11 @@ CONFIGS = {
         mi, plate(eta_o=1.5, eta_e=1.5, birefringence=2e-4, thickness=3000.0)),
     "calcite_solids/dielectric": lambda mi: solids(mi, mitsuba_bsdf("dielectric", CALCITE_N_O)),
     "calcite_solids/birefringent": lambda mi: solids(
+        mi, crystal(material="calcite", optic_axis=[1.0, 1.0, 1.0], optic_axis_space="world")),
+    "bouncing_glass/dielectric": lambda mi: bouncing_sphere(mi, mitsuba_bsdf("dielectric", 1.5)),
+    "bouncing_glass/birefringent": lambda mi: bouncing_sphere(mi, crystal(eta_o=1.5, eta_e=1.5)),
+    "bouncing_calcite/dielectric": lambda mi: bouncing_sphere(mi, mitsuba_bsdf("dielectric", CALCITE_N_O)),
+    "bouncing_calcite/birefringent": lambda mi: bouncing_sphere(
         mi, crystal(material="calcite", optic_axis=[1.0, 1.0, 1.0], optic_axis_space="world")),
 }
 
@@ -709,6 +721,14 @@ OVERHEAD_PAIRS = {
     "anisotropic/calcite_solids": Pair(
         "anisotropic", "calcite_solids/birefringent", "calcite_solids/dielectric", POLARIZED,
         f"calcite sphere and cube (optic axis [1, 1, 1] in world space) vs `dielectric` {CALCITE_N_O}"),
+    "isotropic/bouncing_glass_sphere": Pair(
+        "isotropic", "bouncing_glass/birefringent", "bouncing_glass/dielectric", BOTH,
+        "a glass sphere on the floor filling half the frame, light bouncing inside it "
+        "(eta_o = eta_e = 1.5) vs `dielectric` 1.5"),
+    "anisotropic/bouncing_calcite_sphere": Pair(
+        "anisotropic", "bouncing_calcite/birefringent", "bouncing_calcite/dielectric", POLARIZED,
+        "a calcite sphere on the floor filling half the frame, light bouncing inside it (optic axis "
+        f"[1, 1, 1] in world space) vs `dielectric` {CALCITE_N_O}"),
 }
 #: The isotropic fast path at scene level: ours with eta_e = 1.5 + 1e-9 against ours with 1.5.
 FAST_PATH_PAIRS = {

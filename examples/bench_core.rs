@@ -43,7 +43,10 @@ use birefringent::plate::slab::Output;
 use birefringent::plate::slab::{Slab, SlabOptics, Want};
 use birefringent::plate::Plate;
 use birefringent::spectral::model::{Accuracy, PlateModel};
+use birefringent::spectral::route::{self, Route};
+use birefringent::spectral::survey::Survey;
 use birefringent::spectral::weights::weight_per_nm;
+use birefringent::spectral::weights::WeightSet;
 use birefringent::C64;
 use serde_json::{json, Value};
 use spectral_rgb::{Case, Outcome, Rng, QUANTITIES, RANGE, SET};
@@ -62,10 +65,18 @@ const GOAL_SPEEDUP_AT_HALF: f64 = 20.0;
 const HALF_DE: f64 = 0.5;
 const GOAL_ANALYTIC_DE: f64 = 0.5;
 const TARGET_DE: f64 = 1.0;
-/// Per-plate analytic time over the validation set (T Mueller, 3 channels): median, p99, max.
-const GOAL_MEDIAN_US: f64 = 10.0;
-const GOAL_P99_US: f64 = 50.0;
+/// Per-plate analytic time over the extended validation set (T Mueller, 3 channels of
+/// `xyz-d65`): median, mean, p99, max (issue 20, goal 1).
+const GOAL_MEDIAN_US: f64 = 8.0;
+const GOAL_MEAN_US: f64 = 15.0;
+const GOAL_P99_US: f64 = 60.0;
 const GOAL_MAX_US: f64 = 500.0;
+/// The sRGB reflection and transmission Mueller matrices of one render query: median, p99.
+const GOAL_RENDER_MEDIAN_US: f64 = 15.0;
+const GOAL_RENDER_P99_US: f64 = 100.0;
+/// The calculator's analytic `xyz-d65` slab line against its exact (one wavelength) line, on
+/// average over random plates 0.5-1000 um at 0-60 degrees (issue 20, goal 3).
+const GOAL_CALCULATOR_RATIO: f64 = 2.0;
 const T_ONLY: Want = Want {
     reflection: false,
     transmission: true,
@@ -729,58 +740,172 @@ fn stochastic_study(outcomes: &[Outcome], seeds: usize) -> Value {
 
 // ---- analytic time over the validation set -------------------------------------------------------
 
-/// The analytic method's time per plate over every validation plate (transmission Mueller
-/// matrix, 3 channels): the median of `reps` timed calls per plate (after one untimed call,
-/// which builds the rules a first query of a process builds once), and its quantiles.
-fn analytic_timing(outcomes: &[Outcome]) -> Value {
-    let reps = 9;
-    let mut per_plate: Vec<f64> = outcomes
-        .iter()
-        .map(|o| {
-            black_box(analytic_crossed(&o.case, T_ONLY));
-            let mut t: Vec<f64> = (0..reps)
-                .map(|_| {
-                    let t0 = Instant::now();
-                    black_box(analytic_crossed(black_box(&o.case), T_ONLY));
-                    t0.elapsed().as_secs_f64()
-                })
-                .collect();
-            median(&mut t)
-        })
-        .collect();
-    let mean_t = mean(&per_plate);
+/// Quantiles of per-plate times (seconds): median, mean, p90, p99 and max, in microseconds.
+fn quantiles(per_plate: &mut [f64]) -> (f64, f64, f64, f64, f64) {
+    let mean_t = mean(per_plate);
     per_plate.sort_by(f64::total_cmp);
     let n = per_plate.len();
-    let q = |p: f64| per_plate[((p * n as f64).ceil() as usize).clamp(1, n) - 1];
-    let (med, p99, max) = (q(0.5) * 1e6, q(0.99) * 1e6, per_plate[n - 1] * 1e6);
-    let verdict = |x: f64, goal: f64| if x <= goal { "met" } else { "NOT met" };
-    println!(
-        "  analytic (T Mueller, 3 channels) over {n} plates: mean {:.2} us, median {med:.2} us (goal <= {GOAL_MEDIAN_US}: {}), \
-         p90 {:.2} us, p99 {p99:.2} us (goal <= {GOAL_P99_US}: {}), max {max:.1} us (goal <= {GOAL_MAX_US}: {})",
+    let q = |p: f64| per_plate[((p * n as f64).ceil() as usize).clamp(1, n) - 1] * 1e6;
+    (
+        q(0.5),
         mean_t * 1e6,
+        q(0.9),
+        q(0.99),
+        per_plate[n - 1] * 1e6,
+    )
+}
+
+/// The median of `reps` timed calls of `f` (after one untimed call, which builds the rules a
+/// first query of a process builds once), in seconds.
+fn median_time(reps: usize, mut f: impl FnMut()) -> f64 {
+    f();
+    let mut t: Vec<f64> = (0..reps)
+        .map(|_| {
+            let t0 = Instant::now();
+            f();
+            t0.elapsed().as_secs_f64()
+        })
+        .collect();
+    median(&mut t)
+}
+
+fn verdict(x: f64, goal: f64) -> &'static str {
+    if x <= goal {
+        "met"
+    } else {
+        "NOT met"
+    }
+}
+
+/// The analytic method's time per plate over every plate of the extended set (`cases`): the
+/// transmission Mueller matrix over the three channels of `xyz-d65` (goal 1), and the sRGB
+/// reflection and transmission Mueller matrices a render query asks for (`srgb-d65`, both
+/// lobes), each the median of 9 timed calls per plate; and per route, its share of the plates
+/// and its median.
+fn analytic_timing(cases: &[Case]) -> Value {
+    let reps = 9;
+    let time = |c: &Case, set: WeightSet, want: Want| {
+        median_time(reps, || {
+            black_box(
+                PlateModel::new(black_box(&c.plate), c.frame(), c.beta())
+                    .channels(set, want, Output::Mueller, Accuracy::Perceptual)
+                    .unwrap(),
+            );
+        })
+    };
+    let mut xyz: Vec<f64> = cases.iter().map(|c| time(c, SET, T_ONLY)).collect();
+    let mut render: Vec<f64> = cases
+        .iter()
+        .map(|c| time(c, WeightSet::SrgbD65, Want::BOTH))
+        .collect();
+    let mut routes: std::collections::BTreeMap<&'static str, Vec<f64>> = Default::default();
+    for (c, t) in cases.iter().zip(&xyz) {
+        let survey = Survey::new(&c.plate, c.frame(), c.beta()).unwrap();
+        let name = match route::choose(&survey, SET).unwrap() {
+            Route::Envelope(e) if e.families.is_none() => "envelope (whole plate)",
+            Route::Envelope(_) => "envelope (families of orders)",
+            Route::Classes(_) => "path classes",
+            Route::Dense(_) => "dense rule",
+            Route::Evanescent(_) => "evanescent (exact blocks)",
+        };
+        routes.entry(name).or_default().push(*t);
+    }
+    let n = cases.len();
+    let (med, mean_t, p90, p99, max) = quantiles(&mut xyz);
+    let (rmed, rmean, rp90, rp99, rmax) = quantiles(&mut render);
+    println!(
+        "  xyz-d65 T Mueller over {n} plates: median {med:.2} us (goal <= {GOAL_MEDIAN_US}: {}), mean {mean_t:.2} us \
+         (goal <= {GOAL_MEAN_US}: {}), p90 {p90:.1} us, p99 {p99:.1} us (goal <= {GOAL_P99_US}: {}), max {max:.1} us \
+         (goal <= {GOAL_MAX_US}: {})",
         verdict(med, GOAL_MEDIAN_US),
-        q(0.9) * 1e6,
+        verdict(mean_t, GOAL_MEAN_US),
         verdict(p99, GOAL_P99_US),
         verdict(max, GOAL_MAX_US),
     );
+    println!(
+        "  srgb-d65 R and T Mueller (a render query) over {n} plates: median {rmed:.2} us (goal <= {GOAL_RENDER_MEDIAN_US}: {}), \
+         mean {rmean:.2} us, p90 {rp90:.1} us, p99 {rp99:.1} us (goal <= {GOAL_RENDER_P99_US}: {}), max {rmax:.1} us",
+        verdict(rmed, GOAL_RENDER_MEDIAN_US),
+        verdict(rp99, GOAL_RENDER_P99_US),
+    );
+    let per_route: serde_json::Map<String, Value> = routes
+        .iter_mut()
+        .map(|(name, t)| {
+            let count = t.len();
+            let (m, avg, _, _, worst) = quantiles(t);
+            println!(
+                "    {name}: {count} plates ({:.0} %), median {m:.2} us, mean {avg:.2} us, max {worst:.1} us",
+                100.0 * count as f64 / n as f64
+            );
+            (
+                name.to_string(),
+                json!({"plates": count, "median_us": m, "mean_us": avg, "max_us": worst}),
+            )
+        })
+        .collect();
     json!({
         "plates": n,
         "repetitions_per_plate": reps,
-        "mean_us": mean_t * 1e6,
-        "median_us": med, "p90_us": q(0.9) * 1e6, "p99_us": p99, "max_us": max,
-        "goals": {
-            "median_us": GOAL_MEDIAN_US, "median_met": med <= GOAL_MEDIAN_US,
-            "p99_us": GOAL_P99_US, "p99_met": p99 <= GOAL_P99_US,
-            "max_us": GOAL_MAX_US, "max_met": max <= GOAL_MAX_US,
+        "xyz_transmission": {
+            "median_us": med, "mean_us": mean_t, "p90_us": p90, "p99_us": p99, "max_us": max,
+            "goals": {
+                "median_us": GOAL_MEDIAN_US, "median_met": med <= GOAL_MEDIAN_US,
+                "mean_us": GOAL_MEAN_US, "mean_met": mean_t <= GOAL_MEAN_US,
+                "p99_us": GOAL_P99_US, "p99_met": p99 <= GOAL_P99_US,
+                "max_us": GOAL_MAX_US, "max_met": max <= GOAL_MAX_US,
+            },
         },
+        "srgb_render_query": {
+            "median_us": rmed, "mean_us": rmean, "p90_us": rp90, "p99_us": rp99, "max_us": rmax,
+            "goals": {
+                "median_us": GOAL_RENDER_MEDIAN_US, "median_met": rmed <= GOAL_RENDER_MEDIAN_US,
+                "p99_us": GOAL_RENDER_P99_US, "p99_met": rp99 <= GOAL_RENDER_P99_US,
+            },
+        },
+        "routes": per_route,
     })
+}
+
+/// The calculator's analytic `xyz-d65` slab line against its exact line (one wavelength, 550
+/// nm), each as `birefringence slab` runs a line (JSON in, JSON out), over random plates
+/// 0.5-1000 um at 0-60 degrees (the crystals and constant indices of the validation set):
+/// the mean time per line of each, and their ratio (goal 3).
+fn calculator(plates: usize) -> Value {
+    let mut rng = Rng::new(0xCA1C);
+    let mut exact = Vec::with_capacity(plates);
+    let mut analytic = Vec::with_capacity(plates);
+    for i in 0..plates {
+        let mut case = spectral_rgb::random_case(&mut rng, i);
+        case.plate.thickness_nm = rng.log_range(500.0, 1e6);
+        case.theta_deg = rng.range(0.0, 60.0);
+        let line = case.reproducer();
+        let mut mono = line.clone();
+        mono.as_object_mut().expect("an object").remove("spectrum");
+        let (mono, line) = (mono.to_string(), line.to_string());
+        let run = |text: &str| {
+            let (out, ok) = birefringent::calc::run_text("slab", text);
+            assert!(ok, "{text}: {out}");
+            black_box(out.to_string());
+        };
+        exact.push(median_time(9, || run(&mono)));
+        analytic.push(median_time(9, || run(&line)));
+    }
+    let (e, a) = (mean(&exact) * 1e6, mean(&analytic) * 1e6);
+    let ratio = a / e;
+    println!(
+        "  calculator, {plates} random plates 0.5-1000 um at 0-60 deg: exact line {e:.1} us, analytic xyz-d65 line {a:.1} us on average: \
+         ratio {ratio:.2} (goal <= {GOAL_CALCULATOR_RATIO}: {})",
+        verdict(ratio, GOAL_CALCULATOR_RATIO)
+    );
+    json!({"plates": plates, "exact_line_mean_us": e, "analytic_line_mean_us": a, "ratio": ratio,
+           "goal_ratio": GOAL_CALCULATOR_RATIO, "met": ratio <= GOAL_CALCULATOR_RATIO})
 }
 
 // ---- validation ------------------------------------------------------------------------------
 
 fn validation(n: usize) -> (Vec<Outcome>, Value) {
     let t = Instant::now();
-    let cases = spectral_rgb::cases(n, spectral_rgb::TEST_SEED ^ 0xBE7C);
+    let cases = spectral_rgb::extended_cases(n, spectral_rgb::TEST_SEED ^ 0xBE7C);
     let mut outcomes = Vec::with_capacity(n);
     for c in &cases {
         outcomes.push(spectral_rgb::compare(c, true));
@@ -936,7 +1061,10 @@ fn main() {
     report.insert("validation".into(), v);
 
     println!("analytic time per plate over the validation set:");
-    report.insert("analytic_time".into(), analytic_timing(&outcomes));
+    let cases: Vec<Case> = outcomes.iter().map(|o| o.case.clone()).collect();
+    report.insert("analytic_time".into(), analytic_timing(&cases));
+    println!("the calculator's lines:");
+    report.insert("calculator".into(), calculator(200));
 
     println!(
         "error vs time, crossed polarisers, {} plates x {} seeds:",

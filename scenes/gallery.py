@@ -1,11 +1,13 @@
 """Render every scene of this directory at gallery size and put them on one contact sheet.
 
     .venv/bin/python scenes/gallery.py [--out out/gallery] [--sheet scenes/gallery.png]
-        [--width 320] [--spp 16] [--only NAME ...] [--reuse]
+        [--width 320] [--spp 16] [--sampler multijitter] [--only NAME ...] [--reuse]
 
 Scenes are the modules `render.scene_names()` finds (a `scene` function and `VARIANTS`), each
 rendered in its default variant at `--width` pixels wide (the height keeps the aspect of the
-scene's default width and height) with `--spp` samples per pixel, unless the module has a dict
+scene's default width and height) with `--spp` samples per pixel and the sampler `--sampler`
+(`render.SAMPLER`, multijitter: it stratifies the choice between a plate's reflection and
+transmission), unless the module has a dict
 `GALLERY` of options for the gallery (e.g. fewer samples for a costly scene). Each goes to
 `<out>/<name>.exr` and `.png` (`render.render`); the contact sheet has the images in a grid with
 the scene's name and the first paragraph of its docstring under each.
@@ -70,6 +72,8 @@ def main() -> None:
     p.add_argument("--sheet", type=pathlib.Path, default=HERE / "gallery.png")
     p.add_argument("--width", type=int, default=320)
     p.add_argument("--spp", type=int, default=16)
+    p.add_argument("--sampler", default=render.SAMPLER,
+                   help="the sensor's sampler type (default %(default)s; 'scene': the scene's own)")
     p.add_argument("--only", nargs="*", default=None, help="render only these scenes")
     p.add_argument("--reuse", action="store_true",
                    help="use the PNGs already in --out where they exist (only redraw the sheet)")
@@ -81,7 +85,8 @@ def main() -> None:
         module = importlib.import_module(name)
         png = a.out / f"{name}.png"
         if not (a.reuse and png.exists()):
-            png = render.render(name, a.out, **gallery_options(module, a.width, a.spp))
+            png = render.render(name, a.out, sampler=a.sampler,
+                                **gallery_options(module, a.width, a.spp))
         caption = " ".join((module.__doc__ or "").strip().split("\n\n")[0].split())
         entries.append((name, caption, png))
     contact_sheet(entries, a.sheet)

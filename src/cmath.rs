@@ -113,23 +113,22 @@ pub fn inv(z: C64) -> C64 {
 /// real (lossless media, propagating waves) is solved in real arithmetic, the same steps.
 pub fn solve4(a: &Matrix4<C64>, b: &Matrix4<C64>) -> Option<Matrix4<C64>> {
     if a.iter().chain(b.iter()).all(|z| z.im == 0.0) {
-        let x = solve4_in(&a.map(|z| z.re), &b.map(|z| z.re))?;
-        return Some(x.map(|v| C64::new(v, 0.0)));
+        let x = solve4_columns(&a.map(|z| z.re), &[b.map(|z| z.re)])?;
+        return Some(x[0].map(|v| C64::new(v, 0.0)));
     }
-    solve4_in(a, b)
+    let x = solve4_columns(a, &[*b])?;
+    Some(x[0])
 }
 
-/// [`solve4`] in the arithmetic of `T`.
-#[inline]
-fn solve4_in<T: Scalar + nalgebra::Scalar>(a: &Matrix4<T>, b: &Matrix4<T>) -> Option<Matrix4<T>> {
-    // Rows of the augmented system [A | B].
-    let mut m = [[T::ZERO; 8]; 4];
-    for (i, row) in m.iter_mut().enumerate() {
-        for j in 0..4 {
-            row[j] = a[(i, j)];
-            row[4 + j] = b[(i, j)];
-        }
-    }
+/// [`solve4`] for several right-hand sides at once (one elimination), in the arithmetic of `T`.
+pub fn solve4_columns<T: Scalar + nalgebra::Scalar, const N: usize>(
+    a: &Matrix4<T>,
+    b: &[Matrix4<T>; N],
+) -> Option<[Matrix4<T>; N]> {
+    // Rows of A, and of every B, eliminated together.
+    let mut m: [[T; 4]; 4] = std::array::from_fn(|i| std::array::from_fn(|j| a[(i, j)]));
+    let mut r: [[[T; 4]; N]; 4] =
+        std::array::from_fn(|i| std::array::from_fn(|k| std::array::from_fn(|j| b[k][(i, j)])));
     let scale = a.iter().map(|z| z.norm_sqr()).fold(0.0, f64::max);
     for col in 0..4 {
         let mut pivot = col;
@@ -143,29 +142,50 @@ fn solve4_in<T: Scalar + nalgebra::Scalar>(a: &Matrix4<T>, b: &Matrix4<T>) -> Op
             return None;
         }
         m.swap(col, pivot);
+        r.swap(col, pivot);
         let inv = p.inverse();
-        let pivot_row = {
-            let r = &mut m[col];
-            for v in r.iter_mut().skip(col) {
+        for v in m[col].iter_mut().skip(col) {
+            *v = *v * inv;
+        }
+        for block in r[col].iter_mut() {
+            for v in block.iter_mut() {
                 *v = *v * inv;
             }
-            *r
-        };
-        for (i, row) in m.iter_mut().enumerate() {
+        }
+        let (pm, pr) = (m[col], r[col]);
+        for i in 0..4 {
             if i == col {
                 continue;
             }
-            let f = row[col];
-            for j in col..8 {
-                row[j] = row[j] - f * pivot_row[j];
+            let f = m[i][col];
+            for j in col..4 {
+                m[i][j] = m[i][j] - f * pm[j];
+            }
+            for (block, pb) in r[i].iter_mut().zip(&pr) {
+                for (v, pv) in block.iter_mut().zip(pb) {
+                    *v = *v - f * *pv;
+                }
             }
         }
     }
-    Some(Matrix4::from_fn(|i, j| m[i][4 + j]))
+    Some(std::array::from_fn(|k| Matrix4::from_fn(|i, j| r[i][k][j])))
 }
 
-/// Uniform numbers in `[0, 1)` from a 64-bit linear congruential generator (Knuth's MMIX
-/// constants, the top 53 bits): reproducible inputs for the unit tests.
+/// `a b` for 4×4 complex matrices, written out (the generic product is several times slower).
+#[inline]
+pub fn mul4(a: &Matrix4<C64>, b: &Matrix4<C64>) -> Matrix4<C64> {
+    let mut out = Matrix4::zeros();
+    for j in 0..4 {
+        for k in 0..4 {
+            let bkj = b[(k, j)];
+            for i in 0..4 {
+                out[(i, j)] += a[(i, k)] * bkj;
+            }
+        }
+    }
+    out
+}
+
 /// `a b`, written out.
 #[inline(always)]
 pub fn mul2(a: &Matrix2<C64>, b: &Matrix2<C64>) -> Matrix2<C64> {
@@ -186,6 +206,8 @@ pub fn spectral_norm(a: &nalgebra::Matrix2<C64>) -> f64 {
     (0.5 * (f2 + (f2 * f2 - 4.0 * det).max(0.0).sqrt())).sqrt()
 }
 
+/// Uniform numbers in `[0, 1)` from a 64-bit linear congruential generator (Knuth's MMIX
+/// constants, the top 53 bits): reproducible inputs for the unit tests.
 #[cfg(test)]
 pub(crate) fn uniform(seed: u64) -> impl FnMut() -> f64 {
     let mut state = seed;
@@ -245,7 +267,7 @@ mod tests {
             let a = Matrix4::from_fn(|_, _| C64::new(next(), 0.0));
             let b = Matrix4::from_fn(|_, _| C64::new(next(), 0.0));
             let real = solve4(&a, &b).unwrap();
-            let complex = solve4_in(&a, &b).unwrap();
+            let complex = solve4_columns(&a, &[b]).unwrap()[0];
             for (r, c) in real.iter().zip(complex.iter()) {
                 assert_eq!(r.re, c.re);
                 assert_eq!(c.im, 0.0);

@@ -15,6 +15,7 @@ pub mod optics;
 pub mod params;
 pub mod plate;
 pub mod render;
+pub mod scratch;
 pub mod spectral;
 pub mod stack;
 

@@ -124,6 +124,45 @@ fn invalid_inputs_name_the_parameter_and_exit_non_zero() {
     assert_eq!(code, 2, "usage error");
 }
 
+/// A length, wavelength or angle written without the unit its field's name carries gets the
+/// field to use: `thickness` -> `thickness_um`, `wavelength` -> `wavelength_nm`, `theta` ->
+/// `theta_deg`; a field with no such counterpart gets the list alone.
+#[test]
+fn a_field_without_its_unit_names_the_field_with_it() {
+    let cases = [
+        (
+            "slab",
+            r#"{"wavelength_nm": 550, "eta_o": 1.5, "eta_e": 1.6, "optic_axis": [1,0,0], "theta_deg": 0, "thickness": 3}"#,
+            Some("thickness: unknown field (did you mean thickness_um (the unit is part of the name)? accepted: "),
+        ),
+        (
+            "interface",
+            r#"{"wavelength": 550, "eta_o": 1.5, "eta_e": 1.6, "optic_axis": [1,0,0], "theta_deg": 0}"#,
+            Some("wavelength: unknown field (did you mean wavelength_nm"),
+        ),
+        (
+            "interface",
+            r#"{"wavelength_nm": 550, "eta_o": 1.5, "eta_e": 1.6, "optic_axis": [1,0,0], "theta": 0}"#,
+            Some("theta: unknown field (did you mean theta_deg"),
+        ),
+        (
+            "interface",
+            r#"{"wavelength_nm": 550, "eta_o": 1.5, "eta_e": 1.6, "optic_axis": [1,0,0], "theta_deg": 0, "thick": 1}"#,
+            None,
+        ),
+    ];
+    for (command, input, want) in cases {
+        let (code, out) = run(&[command], input);
+        assert_eq!(code, 1, "{input}");
+        let v: Value = serde_json::from_str(&out).unwrap();
+        let msg = v["error"].as_str().unwrap();
+        match want {
+            Some(w) => assert!(msg.starts_with(w), "{input} -> {msg}"),
+            None => assert!(msg.starts_with("thick: unknown field (accepted: "), "{msg}"),
+        }
+    }
+}
+
 #[test]
 fn inside_incidence_and_named_materials() {
     let input = r#"{"wavelength_nm": 589.3, "material": "calcite", "ext_ior": "water", "optic_axis": [0.5, 0.2, 0.8], "theta_deg": 20, "side": "inside", "inside_mode": "e"}"#;

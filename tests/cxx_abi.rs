@@ -155,7 +155,7 @@ fn cxx_program_agrees_with_the_rust_side() {
     assert_eq!(lines[1], "bounds 4 2 3");
     assert_eq!(lines[2], "materials 0 1 0 1");
     assert!(
-        lines[3].starts_with("bad material [material: unknown crystal 'unobtainium' (known: "),
+        lines[3].starts_with("bad material [material: unknown crystal 'unobtainium'; the catalogue's names: calcite, quartz (crystalline quartz), "),
         "{}",
         lines[3]
     );

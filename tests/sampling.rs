@@ -238,11 +238,14 @@ fn fresnel_reflection(n1: f64, eta: C64, cos1: f64) -> (f64, f64, C64) {
 /// An absorbing (isotropic) bulk surface is opaque, like Mitsuba's `conductor`
 /// (src/render/crystal.rs): from outside the reflection lobe alone, in both transport modes,
 /// its Mueller matrix the closed-form Fresnel reflection of the complex index in the s/p frame
-/// (Stokes x = s) to 1e-12 (measured 2.4e-13: the same amplitudes by another route); from
+/// (Stokes x = s) to 3e-12 (the same amplitudes by another route: measured 2.4e-13 for κ ≥ 1,
+/// 9.8e-13 for 1.7 + 0.01i under an exterior of 1.5 at cos θ = 1e-3, near grazing); from
 /// inside no lobes (before: Importance returned lobes with weights up to 2.07 for 1.5 + 3i,
 /// found by the fuzzer, and from outside a refraction lobe whose Radiance weight was 1470 for
 /// silver at normal incidence). Conductors (silver, a gold-like index, the smallest accepted
-/// real part with κ = 1) and lossy dielectrics, exteriors 1 and 1.5.
+/// real part with κ = 1) and lossy dielectrics, down to κ = 1e-9 (any absorption makes the bulk
+/// opaque: with "opaque" decided above a tolerance, κ = 1e-3 refracted 90 % of the samples and
+/// gained energy from inside), exteriors 1 and 1.5.
 #[test]
 fn absorbing_bulk_surface_is_opaque_like_a_conductor() {
     let mut rng = Rng::new(35);
@@ -254,6 +257,10 @@ fn absorbing_bulk_surface_is_opaque_like_a_conductor() {
         C64::new(1.5, 1.0),
         C64::new(0.5, 1.0),
         C64::new(1.5, 3.0),
+        C64::new(1.7, 1e-2),
+        C64::new(1.33, 1e-3),
+        C64::new(2.4, 1e-6),
+        C64::new(1.5, 1e-9),
     ] {
         for ext in [1.0, 1.5] {
             let crystal = Uniaxial::isotropic(eta).unwrap();
@@ -273,8 +280,9 @@ fn absorbing_bulk_surface_is_opaque_like_a_conductor() {
                     assert_eq!(lobes.len(), 1, "{eta} {t:?}: {lobes:?}");
                     let l = &lobes[0];
                     assert_eq!(l.component, 0);
+                    // Rounding of the general event's ray directions: measured 1.2e-13.
                     let dw = (l.wo - Vector3::new(-wi.x, -wi.y, wi.z)).norm();
-                    assert!(dw < 1e-13, "{dw:e}");
+                    assert!(dw < 1e-12, "{dw:e}");
                     assert_eq!(l.eta, 1.0);
                     // s axis of both frames: perpendicular to the plane of incidence.
                     let s_axis = Vector3::z().cross(&wi).normalize();
@@ -317,7 +325,7 @@ fn absorbing_bulk_surface_is_opaque_like_a_conductor() {
         }
     }
     println!("opaque absorbing bulk: worst |M - closed form| = {worst:e}");
-    assert!(worst < 1e-12);
+    assert!(worst < 3e-12);
 }
 
 /// A band narrower than `EXACT_BAND` of its wavelength is the exact single-wavelength result;

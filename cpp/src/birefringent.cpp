@@ -9,20 +9,22 @@ Bulk birefringent crystal (:monosp:`birefringent`)
 
  * - material
    - |string|
-   - A named uniaxial crystal of the core's catalogue: calcite, crystalline quartz (quartz),
-     sapphire, rutile, magnesium fluoride (mgf2), lithium niobate, beta barium borate, potassium
-     dihydrogen phosphate (aliases accepted); dispersive. Each uses one cited dispersion fit
-     over its range; Mitsuba samples 360-830 nm, and where a fit's data stop short (rutile:
-     DeVore 1951, 430-1530 nm; lithium niobate: Zelmon et al. 1997, 400-5000 nm) the fit is
-     extrapolated down to 360 nm (finite and of normal dispersion there, but without rutile's
-     absorption below about 410 nm) and loading logs one warning saying so; the calculator
-     applies the same rule. (Default: ``calcite``)
+   - A named uniaxial crystal of the core's catalogue: ``calcite``, ``quartz``, ``sapphire``,
+     ``rutile``, ``mgf2``, ``linbo3``, ``bbo``, ``kdp`` (the names the calculator uses too; the
+     full names, e.g. "crystalline quartz", "lithium niobate", and any case are accepted);
+     dispersive. Each uses one cited dispersion fit over its range; Mitsuba samples 360-830 nm,
+     and where a fit's data stop short (rutile: DeVore 1951, 430-1530 nm; linbo3: Zelmon et al.
+     1997, 400-5000 nm) the fit is extrapolated down to 360 nm (finite and of normal dispersion
+     there, but without rutile's absorption below about 410 nm) and loading logs one warning
+     saying so; the calculator applies the same rule. (Default: ``calcite``, said in a warning
+     at load; a plate given ``birefringence`` alone is a glass instead, see there)
 
  * - eta_o, eta_e
    - |float|
-   - Constant ordinary / extraordinary indices instead of ``material`` (give both; not together
-     with ``material``), within [1e-3, 1e3] (as is every index). Spectra are not supported
-     yet. Exposed only when given.
+   - Constant ordinary / extraordinary indices instead of ``material`` (give both, equal for
+     an isotropic glass; not together with ``material``), within [1e-3, 1e3] (as is every
+     index). Floats only: an index that varies with wavelength is a ``material``. Exposed only
+     when given (or when a plate's glass default stands for them).
    - |exposed|
 
  * - kappa_o, kappa_e
@@ -39,7 +41,7 @@ Bulk birefringent crystal (:monosp:`birefringent`)
  * - optic_axis
    - |vector|
    - The optic axis, any non-zero length, in the frame that ``optic_axis_space`` names.
-     (Default: ``[1, 0, 0]``)
+     (Default: ``[1, 0, 0]``, said in a warning at load for a birefringent material)
    - |exposed|
 
  * - optic_axis_space
@@ -110,9 +112,28 @@ public:
     /// their `channel`'s mean wavelength.
     static constexpr double RgbWavelength = 550.0;
 
+    /// Parameters of other plugins a Mitsuba user is likely to give a bulk crystal, and what to
+    /// give.
+    static constexpr shim::Foreign Foreign[] = {
+        { "int_ior", "the crystal's indices are eta_o and eta_e, or \"material\"; the medium "
+                     "outside is ext_ior" },
+        { "thickness", "a bulk crystal's surface has no thickness (the crystal fills the shape); "
+                       "a plate is \"thinbirefringent\"" },
+        { "birefringence", "a stress birefringence is a parameter of \"thinbirefringent\" (a "
+                           "plate); a bulk crystal takes its birefringence from eta_o and eta_e, "
+                           "or \"material\"" },
+        { "axis_angle", "axis_angle is a parameter of \"thinbirefringent\" (a plate); a bulk "
+                        "crystal's axis is optic_axis, in the frame optic_axis_space names" },
+        { "exit_ior", "the medium behind a bulk crystal's surface is the crystal itself; a plate "
+                      "between two media is \"thinbirefringent\"" },
+    };
+
     Birefringent(const Properties &props) : Base(props) {
-        m_params = shim::parse_material(props, ClassName);
+        shim::refuse_foreign(props, Foreign, ClassName);
+        shim::Defaults defaults;
+        m_params = shim::parse_material(props, ClassName, defaults);
         m_ext_ior = shim::parse_ior(props, "ext_ior", "air", ClassName);
+        shim::require_vector(props, "optic_axis", ClassName);
         m_optic_axis = props.get<ScalarVector3f>("optic_axis", ScalarVector3f(1.f, 0.f, 0.f));
         std::string space = props.get<std::string>("optic_axis_space", "local");
         if (space != "local" && space != "world")
@@ -122,6 +143,10 @@ public:
         if constexpr (is_monochromatic_v<Spectrum>)
             m_wavelength = shim::core_call(ClassName, [&] { return bfr::colour_channel_wavelength(m_channel); });
         parameters_changed();
+        if (!props.has_property("optic_axis") && !m_material->is_isotropic(0))
+            defaults.add("optic_axis = [1, 0, 0] in the shading frame of each hit (give it, and "
+                         "optic_axis_space \"world\" for a crystal object such as a cube)");
+        defaults.log(ClassName);
     }
 
     void traverse(TraversalCallback *cb) override {

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "rust/cxx.h"
 #include "birefringent/src/ffi/mod.rs.h"
@@ -38,22 +39,94 @@ struct MaterialParams {
 /* The functions below take `ClassName` as a parameter so that Mitsuba's Throw/Log macros, which
    refer to a variable of that name, tag their messages with the plugin's class. */
 
+/// What a plugin took by default for parameters that shape the image, said in one warning at
+/// load (a default never passes silently: `{"type": "thinbirefringent", "birefringence": 2e-4}`
+/// once loaded as 1 um of calcite without a word).
+struct Defaults {
+    std::vector<std::string> notes;
+
+    void add(std::string note) { notes.push_back(std::move(note)); }
+
+    void log(const char *ClassName) const {
+        if (notes.empty())
+            return;
+        std::string all;
+        for (const std::string &n : notes)
+            all += (all.empty() ? "" : "; ") + n;
+        Log(Warn, "not given, so by default: %s. Give them to choose (and to silence this "
+                  "warning).", all);
+    }
+};
+
+/// The isotropic glass of a plate given a stress `birefringence` but no material: Mitsuba's
+/// "bk7" (its ior.h), which is also `thindielectric`'s default `int_ior`.
+constexpr double DefaultGlassIndex = 1.5046;
+
+/// Throws unless property `name` (if given) is a number: a colour, spectrum or texture gets a
+/// message that names the parameter and says `fix`, instead of Mitsuba's `expected float, got
+/// rgb`.
+inline void require_number(const Properties &props, const char *name, const char *fix,
+                           const char *ClassName) {
+    if (!props.has_property(name))
+        return;
+    auto type = props.type(name);
+    if (type != Properties::Type::Float && type != Properties::Type::Integer)
+        Throw("\"%s\" must be a float, got %s: %s", name, property_type_name(type), fix);
+}
+
+/// Throws unless property `name` (if given) is a vector, saying how to write one (instead of
+/// Mitsuba's `expected vector, got float`).
+inline void require_vector(const Properties &props, const char *name, const char *ClassName) {
+    if (props.has_property(name) && props.type(name) != Properties::Type::Vector)
+        Throw("\"%s\" must be a vector, got %s: in XML <vector name=\"%s\" x=\"1\" y=\"0\" "
+              "z=\"0\"/>, in a dict [1, 0, 0] (any non-zero length)",
+              name, property_type_name(props.type(name)), name);
+}
+
 /// `material` (string) or `eta_o` + `eta_e` (floats); `kappa_o`, `kappa_e` (floats, default 0).
-/// Without either, the material is "calcite".
-inline MaterialParams parse_material(const Properties &props, const char *ClassName) {
+/// Without either the material is "calcite", or, when `stressed` (a plate given a stress
+/// `birefringence`: what a photoelasticity user writes for stressed glass), the isotropic glass
+/// DefaultGlassIndex; either default is noted in `defaults`.
+inline MaterialParams parse_material(const Properties &props, const char *ClassName,
+                                     Defaults &defaults, bool stressed = false) {
     MaterialParams m;
     bool has_o = props.has_property("eta_o"), has_e = props.has_property("eta_e");
     if (props.has_property("material") && (has_o || has_e))
         Throw("give either \"material\" or \"eta_o\" and \"eta_e\", not both");
     if (has_o != has_e)
-        Throw("\"%s\" is missing (\"%s\" is given): give both eta_o and eta_e, or \"material\"",
+        Throw("\"%s\" is missing (\"%s\" is given): give both eta_o and eta_e (equal for an "
+              "isotropic glass), or \"material\"",
               has_o ? "eta_e" : "eta_o", has_o ? "eta_o" : "eta_e");
+    const char *constant_index =
+        "a constant real index; for an index that varies with wavelength give \"material\" "
+        "instead, a named crystal with its measured dispersion (e.g. \"quartz\"; the catalogue "
+        "is in plugin/README.md): spectra, colours and textures are not supported for eta_o "
+        "and eta_e";
+    require_number(props, "eta_o", constant_index, ClassName);
+    require_number(props, "eta_e", constant_index, ClassName);
+    const char *constant_kappa = "a constant extinction coefficient (spectra, colours and "
+                                 "textures are not supported for kappa_o and kappa_e)";
+    require_number(props, "kappa_o", constant_kappa, ClassName);
+    require_number(props, "kappa_e", constant_kappa, ClassName);
     if (has_o) {
         m.named = false;
         m.eta_o = props.get<double>("eta_o");
         m.eta_e = props.get<double>("eta_e");
+    } else if (props.has_property("material")) {
+        m.material = props.get<std::string>("material");
+    } else if (stressed) {
+        m.named = false;
+        m.eta_o = m.eta_e = DefaultGlassIndex;
+        std::ostringstream oss;
+        oss << "an isotropic glass, eta_o = eta_e = " << DefaultGlassIndex
+            << " (Mitsuba's \"bk7\", thindielectric's default), made birefringent by "
+               "\"birefringence\" alone (give eta_o = eta_e = your glass's index, or "
+               "\"material\" for a crystal)";
+        defaults.add(oss.str());
     } else {
-        m.material = props.get<std::string>("material", "calcite");
+        m.material = "calcite";
+        defaults.add("material = \"calcite\" (a strongly birefringent crystal; give "
+                     "\"material\", or eta_o and eta_e)");
     }
     m.kappa_o = props.get<double>("kappa_o", 0.0);
     m.kappa_e = props.get<double>("kappa_e", 0.0);
@@ -78,6 +151,21 @@ inline uint32_t add_material(bfr::Materials &table, const MaterialParams &p, con
     if (!warning.empty())
         Log(Warn, "%s%s", what, warning);
     return index;
+}
+
+/// A parameter of another plugin that a Mitsuba user is likely to give this one, and what to
+/// give instead.
+struct Foreign {
+    const char *name, *fix;
+};
+
+/// Throws if a property of `table` is given, saying what to give instead (Mitsuba's own
+/// message after the constructor would only say "unreferenced property").
+template <size_t N>
+void refuse_foreign(const Properties &props, const Foreign (&table)[N], const char *ClassName) {
+    for (const Foreign &f : table)
+        if (props.has_property(f.name))
+            Throw("\"%s\" is not a parameter of this plugin: %s", f.name, f.fix);
 }
 
 /// The core's one-material table (index 0); throws the core's message (it names the

@@ -9,20 +9,22 @@ Birefringent plate (:monosp:`thinbirefringent`)
 
  * - material
    - |string|
-   - A named uniaxial crystal of the core's catalogue: calcite, crystalline quartz (quartz),
-     sapphire, rutile, magnesium fluoride (mgf2), lithium niobate, beta barium borate, potassium
-     dihydrogen phosphate (aliases accepted); dispersive. Each uses one cited dispersion fit
-     over its range; Mitsuba samples 360-830 nm, and where a fit's data stop short (rutile:
-     DeVore 1951, 430-1530 nm; lithium niobate: Zelmon et al. 1997, 400-5000 nm) the fit is
-     extrapolated down to 360 nm (finite and of normal dispersion there, but without rutile's
-     absorption below about 410 nm) and loading logs one warning saying so; the calculator
-     applies the same rule. (Default: ``calcite``)
+   - A named uniaxial crystal of the core's catalogue: ``calcite``, ``quartz``, ``sapphire``,
+     ``rutile``, ``mgf2``, ``linbo3``, ``bbo``, ``kdp`` (the names the calculator uses too; the
+     full names, e.g. "crystalline quartz", "lithium niobate", and any case are accepted);
+     dispersive. Each uses one cited dispersion fit over its range; Mitsuba samples 360-830 nm,
+     and where a fit's data stop short (rutile: DeVore 1951, 430-1530 nm; linbo3: Zelmon et al.
+     1997, 400-5000 nm) the fit is extrapolated down to 360 nm (finite and of normal dispersion
+     there, but without rutile's absorption below about 410 nm) and loading logs one warning
+     saying so; the calculator applies the same rule. (Default: ``calcite``, said in a warning
+     at load; a plate given ``birefringence`` alone is a glass instead, see there)
 
  * - eta_o, eta_e
    - |float|
-   - Constant ordinary / extraordinary indices instead of ``material`` (give both; not together
-     with ``material``), within [1e-3, 1e3] (as is every index). Spectra are not supported
-     yet. Exposed only when given.
+   - Constant ordinary / extraordinary indices instead of ``material`` (give both, equal for
+     an isotropic glass; not together with ``material``), within [1e-3, 1e3] (as is every
+     index). Floats only: an index that varies with wavelength is a ``material``. Exposed only
+     when given (or when a plate's glass default stands for them).
    - |exposed|
 
  * - kappa_o, kappa_e
@@ -50,8 +52,11 @@ Birefringent plate (:monosp:`thinbirefringent`)
 
  * - thickness
    - |float| or |texture|
-   - Thickness in micrometres (times ``thickness_scale``), within [0, 1e6] (1 m); where a texture
-     gives a value outside, that point returns no light (one warning). (Default: 1)
+   - Thickness in micrometres, um (times ``thickness_scale``): a 3 mm plate is 3000. Within
+     [0, 1e6] um (1 m); where a texture gives a value outside, that point returns no light (one
+     warning). A plate thinner than 0.01 um (a thickness in metres would give it), or a
+     birefringent plate whose retardance is below 1 nm (a photoelastic plate's millimetres given
+     as micrometres) loads with a warning. (Default: 1 um, said in a warning at load)
    - |exposed|
 
  * - thickness_scale
@@ -62,7 +67,11 @@ Birefringent plate (:monosp:`thinbirefringent`)
  * - birefringence
    - |float| or |texture|
    - Added to Re ``eta_e`` (times ``birefringence_scale``): the stress-induced birefringence
-     ``C (sigma_1 - sigma_2)`` of a photoelastic plate. Exposed only when given. (Default: none)
+     ``C (sigma_1 - sigma_2)`` of a photoelastic plate. Given without ``material``, ``eta_o`` and
+     ``eta_e``, the plate is an isotropic glass of index 1.5046 (Mitsuba's ``bk7``, which is
+     also :monosp:`thindielectric`'s default) made birefringent by this alone, and loading says
+     so in a warning; give ``eta_o`` = ``eta_e`` = your glass's index to choose it. Exposed only
+     when given. (Default: none)
    - |exposed|
 
  * - birefringence_scale
@@ -73,8 +82,9 @@ Birefringent plate (:monosp:`thinbirefringent`)
  * - axis_angle
    - |float| or |texture|
    - Degrees; rotates ``optic_axis`` about the normal, counter-clockwise seen from the exterior
-     (from x towards y): the principal stress direction of a photoelastic plate. Exposed only
-     when given. (Default: 0)
+     (from x towards y): the principal stress direction of a photoelastic plate. A uniform value
+     that is a round angle in radians (0.785 = pi/4, 1.571 = pi/2, ...) loads with a warning.
+     Exposed only when given. (Default: 0)
    - |exposed|
 
  * - filter_bandwidth
@@ -157,15 +167,32 @@ public:
     /// Default `filter_bandwidth` (nm, FWHM) of the spectral variants.
     static constexpr double DefaultFilterBandwidth = 0.0;
 
+    /// Parameters of other plugins a Mitsuba user is likely to give a plate, and what to give.
+    static constexpr shim::Foreign Foreign[] = {
+        { "int_ior", "the plate's own index is eta_o and eta_e (equal for a glass plate) or "
+                     "\"material\"; the media on its two sides are ext_ior and exit_ior" },
+        { "optic_axis_space", "a plate's optic_axis is in its shading frame (x = dp/du, z = the "
+                              "normal), rotated by axis_angle; a world-space axis is a parameter "
+                              "of \"birefringent\", the bulk crystal" },
+        { "specular_reflectance", "the plate's reflection and transmission follow from its "
+                                  "indices and thickness; they have no scale factors" },
+        { "specular_transmittance", "the plate's reflection and transmission follow from its "
+                                    "indices and thickness; they have no scale factors" },
+    };
+
     ThinBirefringent(const Properties &props) : Base(props) {
+        shim::refuse_foreign(props, Foreign, ClassName);
         for (const char *name : { "ext_ior", "exit_ior", "filter_bandwidth", "channel", "absorbing_exit" })
             if (props.has_property(name))
                 m_surroundings.push_back(name);
-        m_params = shim::parse_material(props, ClassName);
+        shim::Defaults defaults;
+        m_params = shim::parse_material(props, ClassName, defaults,
+                                        props.has_property("birefringence"));
         m_ext_ior = shim::parse_ior(props, "ext_ior", "air", ClassName);
         m_exit_ior = props.has_property("exit_ior")
                          ? shim::parse_ior(props, "exit_ior", "air", ClassName)
                          : m_ext_ior;
+        shim::require_vector(props, "optic_axis", ClassName);
         m_optic_axis = props.get<ScalarVector3f>("optic_axis", ScalarVector3f(1.f, 0.f, 0.f));
         m_thickness = shim::scalar_texture<Float, Spectrum>(props, "thickness", 1.0,
                                                             "micrometres", ClassName);
@@ -180,7 +207,10 @@ public:
         m_filter_bandwidth = props.get<double>("filter_bandwidth", DefaultFilterBandwidth);
         m_absorbing_exit = props.get<bool>("absorbing_exit", false);
         m_channel = shim::parse_channel<Spectrum>(props, ClassName);
+        if (!props.has_property("thickness"))
+            defaults.add("thickness = 1 um (thickness is in micrometres: a 3 mm plate is 3000)");
         parameters_changed();
+        defaults.log(ClassName);
     }
 
     void traverse(TraversalCallback *cb) override {
@@ -244,6 +274,7 @@ private:
             m_flags = m_components[0] | m_components[1];
         }
         check_at_load();
+        warn_of_units();
     }
 
 public:
@@ -360,6 +391,22 @@ private:
             Throw("%s", shim::core_message(rc, s.message));
     }
 
+    /// The core's warning for a thickness probably in the wrong unit (textures at their mean)
+    /// or an `axis_angle` probably in radians (a uniform one), logged when it differs from the
+    /// last one logged (not again on every update).
+    void warn_of_units() {
+        double thickness = thickness_nm(shim::scalar(m_thickness->mean()));
+        double dn = m_birefringence ? shim::scalar(m_birefringence->mean()) : 0.0;
+        double angle = m_axis_angle && !m_axis_angle->is_spatially_varying()
+                           ? shim::scalar(m_axis_angle->mean())
+                           : std::nan("");
+        std::string warning(
+            m_material->plate_warning(0, thickness, m_birefringence_scale * dn, angle));
+        if (!warning.empty() && warning != m_unit_warning)
+            Log(Warn, "%s", warning);
+        m_unit_warning = warning;
+    }
+
     /// Thickness (nm) from the texture value (um, before scaling).
     double thickness_nm(double thickness_um) const {
         return 1000.0 * m_thickness_scale * thickness_um;
@@ -449,6 +496,7 @@ private:
     bool m_null = true, m_absorbing_exit = false;
     BSDFFlags m_types[(size_t) bfr::Bounds::PlateComponents];
     mutable std::atomic<bool> m_warned { false };
+    std::string m_unit_warning;  ///< the last warn_of_units message
     /// See signed_rgb.h (the JIT variants' films do not warn of negative values).
     shim::SignedRgbGuard m_signed_rgb { is_rgb_v<Spectrum> && !dr::is_jit_v<Float> };
     std::unique_ptr<shim::Snapshot<Float, Spectrum>> m_valid;  ///< last valid state

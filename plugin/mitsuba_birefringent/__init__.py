@@ -9,9 +9,11 @@ Importing the package registers the plugins with Mitsuba's plugin manager::
     mi.set_variant("scalar_spectral_polarized")
     plate = mi.load_dict({"type": "thinbirefringent", "material": "quartz", "thickness": 20.0})
 
-They work in the variants listed in :data:`VARIANTS` (the cuda variants raise a clear error at
-scene load); in the llvm variants, render inside :func:`evaluated_mode` (see its module,
-``jit``). The optics is computed by the Rust core linked into the plugin library; see
+They work in the variants listed in :data:`VARIANTS` (a cuda variant is refused with the llvm
+variant to use: at scene load, or by ``mi.set_variant`` on a machine without a CUDA device); in
+the llvm variants, render inside :func:`evaluated_mode` (see its module, ``jit``). Importing the
+package also makes ``mi.render`` and ``mi.set_variant`` end with the plugins' own message where
+Dr.Jit would hide it (:mod:`.messages`). The optics is computed by the Rust core linked into the plugin library; see
 ``plugin/README.md`` for the parameters. XML scenes render with the command
 ``mitsuba-birefringent`` (:mod:`mitsuba_birefringent.cli`); Mitsuba's own ``mitsuba`` command
 cannot load these plugins.
@@ -25,6 +27,7 @@ from __future__ import annotations
 
 import importlib.metadata
 
+from . import messages
 from .jit import evaluated_mode
 from .library import core_version, library_path, register, supported_variants
 
@@ -45,6 +48,9 @@ register()
 
 #: The Mitsuba variants the plugins work in (as the plugin library registers them).
 VARIANTS = supported_variants()
+
+# The plugins' messages as the last line of mi.render and mi.set_variant (see messages.py).
+messages.install(VARIANTS)
 
 
 def __getattr__(name: str):

@@ -154,7 +154,7 @@ class ChannelScene:
         if "data" in node:
             return mi.Bitmap(np.asarray(node["data"], dtype=np.float32))
         if "filename" in node:
-            resolved = mi.Thread.thread().file_resolver().resolve(str(node["filename"]))
+            resolved = mi.file_resolver().resolve(str(node["filename"]))
             return mi.Bitmap(str(resolved))
         raise ValueError(f"{path}: a bitmap needs \"filename\", \"bitmap\" or \"data\"")
 

@@ -14,7 +14,7 @@ use std::io::{BufRead, Read, Write};
 const USAGE: &str = "usage: birefringence <subcommand> [--batch] [FILE]
 subcommands: interface, slab, stack
 Reads one JSON object (or JSON lines with --batch) from FILE or standard input.
-See README.md for the fields.";
+See docs/calculator.md for the fields.";
 
 fn main() {
     std::process::exit(run());

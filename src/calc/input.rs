@@ -33,9 +33,18 @@ impl<'a> Fields<'a> {
             .collect();
         unknown.sort();
         if let Some(k) = unknown.first() {
+            // A length, wavelength or angle without its unit (`thickness` for `thickness_um`).
+            let hint = accepted
+                .iter()
+                .find(|a| {
+                    a.strip_prefix(k.as_str())
+                        .is_some_and(|u| u.starts_with('_'))
+                })
+                .map(|a| format!("did you mean {a} (the unit is part of the name)? "))
+                .unwrap_or_default();
             return Err(Error::new(
                 fields.qualified(k),
-                format!("unknown field (accepted: {})", accepted.join(", ")),
+                format!("unknown field ({hint}accepted: {})", accepted.join(", ")),
             ));
         }
         Ok(fields)

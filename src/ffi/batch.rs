@@ -15,7 +15,7 @@ use crate::optics::medium::Uniaxial;
 use crate::optics::surface::Surface;
 use crate::params::{Length, Thickness};
 use crate::render::choice::{choose, Choice};
-use crate::render::crystal::crystal_slots;
+use crate::render::crystal::fill_crystal_slots;
 use crate::render::plate::{plate_lobes, PlateQuery, MAX_BANDS};
 use crate::render::slots::{crystal_component, plate_component, Slots, CRYSTAL_SLOTS, PLATE_SLOTS};
 use crate::render::Transport;
@@ -26,8 +26,9 @@ const _: () = assert!(MAX_CHANNELS == MAX_BANDS);
 const _: () = assert!(Bounds::MaxChannels.repr as usize == MAX_CHANNELS);
 const _: () = assert!(Bounds::PlateComponents.repr as usize == PLATE_SLOTS);
 
-/// One lane's lobes per channel and the slot chosen among them.
-pub(super) type Sampled<const S: usize> = Option<([Slots<S>; MAX_CHANNELS], Choice)>;
+/// One lane's lobes per channel: filled in place by a lane (a crystal's are 8 KB, which moving
+/// by value cost more than computing an isotropic crystal's lobes).
+pub(super) type Lobes<const S: usize> = [Slots<S>; MAX_CHANNELS];
 
 /// Samples a plate lobe in every lane (see `bridge::sample_plate`).
 pub fn sample_plate(
@@ -42,7 +43,7 @@ pub fn sample_plate(
         spectrum.check_wavelength_columns(cols.common.wavelengths.count())?;
         let channels = spectrum.channels(cols.common.wavelengths.count());
         let mut output = Output::new(out, lanes.count, channels)?;
-        let lane = |i| plate_lane(materials, spectrum, call, &cols, i);
+        let lane = |i, lobes: &mut _| plate_lane(materials, spectrum, call, &cols, i, lobes);
         write_lanes(
             &mut output,
             lanes.count,
@@ -72,7 +73,7 @@ pub fn sample_crystal(
             ));
         }
         let mut output = Output::new(out, lanes.count, channels)?;
-        let lane = |i| crystal_lane(materials, components, &cols, i);
+        let lane = |i, lobes: &mut _| crystal_lane(materials, components, &cols, i, lobes);
         write_lanes(
             &mut output,
             lanes.count,
@@ -93,32 +94,43 @@ pub(super) fn finish(r: Result<Status>, out: &mut Samples) -> Status {
     })
 }
 
-/// Computes each of the call's `count` lanes (`lane(i)`, skipping inactive ones) and writes it.
+/// Computes each of the call's `count` lanes (`lane(i, lobes)`, skipping inactive ones) and
+/// writes it. A lane fills the channels' slots of `lobes` (one buffer for the call) and returns
+/// the chosen slot, if any.
 pub(super) fn write_lanes<const S: usize>(
     output: &mut Output,
     count: usize,
     active: &Column<u8>,
-    lane: impl Fn(usize) -> Result<Sampled<S>>,
+    lane: impl Fn(usize, &mut Lobes<S>) -> Result<Option<Choice>>,
     component: fn(usize) -> usize,
 ) {
+    let mut lobes = [[None; S]; MAX_CHANNELS];
     for i in 0..count {
-        write_lane(output, i, active.at(i), || lane(i), component);
+        write_lane(
+            output,
+            i,
+            active.at(i),
+            |l| lane(i, l),
+            &mut lobes,
+            component,
+        );
     }
 }
 
-/// Computes lane `i` (unless inactive) and writes it.
+/// Computes lane `i` (unless inactive) into `lobes` and writes it.
 fn write_lane<const S: usize>(
     output: &mut Output,
     i: usize,
     active: u8,
-    lane: impl FnOnce() -> Result<Sampled<S>>,
+    lane: impl FnOnce(&mut Lobes<S>) -> Result<Option<Choice>>,
+    lobes: &mut Lobes<S>,
     component: fn(usize) -> usize,
 ) {
     if active == 0 {
         return output.nothing(i);
     }
-    let written = guarded(lane).and_then(|sampled| match sampled {
-        Some((lobes, choice)) => {
+    let written = guarded(|| lane(lobes)).and_then(|choice| match choice {
+        Some(choice) => {
             let channels = &lobes[..output.channels()];
             output.write(i, channels, choice, component(choice.slot))
         }
@@ -286,7 +298,8 @@ fn plate_lane(
     call: &PlateCall,
     cols: &PlateColumns,
     i: usize,
-) -> Result<Sampled<PLATE_SLOTS>> {
+    lobes: &mut Lobes<PLATE_SLOTS>,
+) -> Result<Option<Choice>> {
     let c = &cols.common;
     let (transport, u) = c.transport_and_sample(i)?;
     let q = PlateQuery::new(
@@ -303,17 +316,19 @@ fn plate_lane(
     .with_absorbing_exit(call.absorbing_exit);
     let (s, pick) = spectrum.lane(c.wavelengths.at(i), c.wavelengths.count());
     let per_channel = plate_lobes(&q, &s, c.wi.at(i), transport)?;
-    Ok(choose_thin(&per_channel, pick, call, u))
+    Ok(choose_thin(&per_channel, pick, call, u, lobes))
 }
 
 /// The lobe of a thin element (a plate or a stack) over the channels of its query, and the
-/// channels the query keeps (`pick`: one of them, for a mono variant's channel).
+/// channels the query keeps (`pick`: one of them, for a mono variant's channel) written to
+/// `lobes`.
 pub(super) fn choose_thin(
     per_channel: &[Slots<PLATE_SLOTS>],
     pick: Option<usize>,
     call: &PlateCall,
     u: f64,
-) -> Sampled<PLATE_SLOTS> {
+    lobes: &mut Lobes<PLATE_SLOTS>,
+) -> Option<Choice> {
     // The lobe is chosen over every channel of the set, also when the query keeps one: the
     // passes of a channel render then choose alike, and their remaining noise (which lobe a
     // path follows) scales the channels together (no colour noise).
@@ -322,7 +337,6 @@ pub(super) fn choose_thin(
         |slot| enabled(call.components, plate_component(slot)),
         u,
     );
-    let mut lobes = [[None; PLATE_SLOTS]; MAX_CHANNELS];
     match pick {
         Some(k) => lobes[0] = per_channel[k],
         None => {
@@ -335,7 +349,7 @@ pub(super) fn choose_thin(
         hero: if pick.is_some() { 0 } else { choice.hero },
         ..choice
     };
-    choice.map(|choice| (lobes, kept(choice)))
+    choice.map(kept)
 }
 
 /// Lane `i` of a crystal batch: the crystal's slots at each wavelength and the choice.
@@ -344,7 +358,8 @@ fn crystal_lane(
     components: u32,
     cols: &CrystalColumns,
     i: usize,
-) -> Result<Sampled<CRYSTAL_SLOTS>> {
+    lobes: &mut Lobes<CRYSTAL_SLOTS>,
+) -> Result<Option<Choice>> {
     let c = &cols.common;
     let (transport, u) = c.transport_and_sample(i)?;
     let material = materials.get(c.material.at(i))?;
@@ -354,16 +369,21 @@ fn crystal_lane(
         c.wi.at(i),
     );
     let channels = c.wavelengths.count();
-    let mut lobes = [[None; CRYSTAL_SLOTS]; MAX_CHANNELS];
-    for (slots, &lambda) in lobes.iter_mut().zip(&c.wavelengths.at(i)[..channels]) {
-        let (eo, ee) = material.indices(lambda, 0.0)?;
-        let surface = Surface::new(ext, Uniaxial::new(eo, ee, axis)?)?;
-        *slots = crystal_slots(&surface, wi, transport)?;
+    let mut last: Option<(C64, C64)> = None;
+    for k in 0..channels {
+        let indices = material.indices(c.wavelengths.at(i)[k], 0.0)?;
+        if last == Some(indices) {
+            // The same indices (a constant material) give the same lobes, bit for bit.
+            lobes[k] = lobes[k - 1];
+            continue;
+        }
+        let surface = Surface::new(ext, Uniaxial::new(indices.0, indices.1, axis)?)?;
+        fill_crystal_slots(&surface, wi, transport, &mut lobes[k])?;
+        last = Some(indices);
     }
-    let choice = choose(
+    Ok(choose(
         &lobes[..channels],
         |slot| enabled(components, crystal_component(slot)),
         u,
-    );
-    Ok(choice.map(|choice| (lobes, choice)))
+    ))
 }

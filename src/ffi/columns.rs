@@ -10,17 +10,12 @@ pub struct Column<'a, T> {
 
 impl<'a, T: Copy> Column<'a, T> {
     /// `data` as a column of `count` lanes: it must hold `count` values or one.
+    #[inline]
     pub fn new(name: &str, data: &'a [T], count: usize) -> Result<Self> {
         if data.len() == count || data.len() == 1 {
             Ok(Column { data })
         } else {
-            Err(Error::new(
-                name,
-                format!(
-                    "column of {} values for {count} lanes (give {count} or 1)",
-                    data.len()
-                ),
-            ))
+            Err(column_error(name, data.len(), count))
         }
     }
 
@@ -33,6 +28,17 @@ impl<'a, T: Copy> Column<'a, T> {
             self.data[i]
         }
     }
+}
+
+/// The error of an input column of `len` values for `count` lanes (out of line: the checks of
+/// every call stay short).
+#[cold]
+#[inline(never)]
+fn column_error(name: &str, len: usize, count: usize) -> Error {
+    Error::new(
+        name,
+        format!("column of {len} values for {count} lanes (give {count} or 1)"),
+    )
 }
 
 /// Three columns: a vector per lane.
@@ -57,19 +63,26 @@ impl<'a> Columns3<'a> {
 }
 
 /// An output column of `len` values, or none (an optional output not asked for).
+#[inline]
 pub fn check_output<T>(name: &str, data: &[T], len: usize, optional: bool) -> Result<()> {
     if data.len() == len || (optional && data.is_empty()) {
         Ok(())
     } else {
-        Err(Error::new(
-            name,
-            format!(
-                "output column of {} values, {len} needed{}",
-                data.len(),
-                if optional { " (or none)" } else { "" }
-            ),
-        ))
+        Err(output_error(name, data.len(), len, optional))
     }
+}
+
+/// The error of [`check_output`] (out of line, as [`column_error`]).
+#[cold]
+#[inline(never)]
+fn output_error(name: &str, found: usize, len: usize, optional: bool) -> Error {
+    Error::new(
+        name,
+        format!(
+            "output column of {found} values, {len} needed{}",
+            if optional { " (or none)" } else { "" }
+        ),
+    )
 }
 
 /// Up to [`MAX_CHANNELS`] wavelength columns.

@@ -3,6 +3,7 @@
 use super::guard::guarded;
 use crate::error::{Error, Result};
 use crate::material::{check_kappa, Material, RENDER_RANGE_NM};
+use crate::params::{angle_warning, thickness_warning, Length, Thickness};
 use crate::C64;
 
 /// Materials by index (see `bridge::Materials`), each with the warning of
@@ -60,6 +61,34 @@ impl Materials {
         self.0
             .get(index as usize)
             .map_or_else(String::new, |(_, w)| w.clone())
+    }
+
+    /// See `bridge::Materials::plate_warning` (a thickness warning only for an index in the
+    /// table and parameters the load check accepts; that check refuses the others).
+    pub fn plate_warning(
+        &self,
+        index: u32,
+        thickness_nm: f64,
+        birefringence: f64,
+        axis_angle_deg: f64,
+    ) -> String {
+        let thickness = guarded(|| {
+            let m = self.get(index)?;
+            let t = Thickness::new("thickness", thickness_nm, Length::Micrometres)?;
+            let (eta_o, eta_e) = m.indices(550.0, birefringence)?;
+            Ok(thickness_warning(
+                "thickness",
+                t,
+                Length::Micrometres,
+                eta_e.re - eta_o.re,
+            ))
+        });
+        let angle = angle_warning("axis_angle", axis_angle_deg);
+        [thickness.ok().flatten(), angle]
+            .into_iter()
+            .flatten()
+            .collect::<Vec<_>>()
+            .join("; ")
     }
 
     /// Material `index`.

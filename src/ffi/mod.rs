@@ -232,6 +232,19 @@ pub mod bridge {
         /// whose cited data do not cover 360-830 nm (where Mitsuba samples), so that its fit is
         /// extrapolated there.
         fn warning(self: &Materials, index: u32) -> String;
+        /// The warning to show when a plate of material `index`, `thickness_nm` thick (the
+        /// plugin's `thickness` times `thickness_scale`, in nm), with `birefringence` added to
+        /// Re eta_e and rotated by `axis_angle_deg` (NaN: none given, or a texture) is loaded,
+        /// empty if none: a thickness probably in the wrong unit (thinner than 10 nm, or a
+        /// birefringent plate with a retardance below 1 nm at 550 nm) or an angle probably in
+        /// radians (see `params::thickness_warning`, `params::angle_warning`).
+        fn plate_warning(
+            self: &Materials,
+            index: u32,
+            thickness_nm: f64,
+            birefringence: f64,
+            axis_angle_deg: f64,
+        ) -> String;
 
         /// What spectrum a plate is evaluated over.
         type PlateSpectrum;

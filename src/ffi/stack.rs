@@ -3,7 +3,7 @@
 //! written to the outputs. Panics are caught per lane.
 
 use super::batch::{
-    choose_thin, enabled, finish, rotated_about_normal, transport_and_sample, write_lanes, Sampled,
+    choose_thin, enabled, finish, rotated_about_normal, transport_and_sample, write_lanes, Lobes,
 };
 use super::bridge::{PlateCall, Samples, StackLanes, Status, Transport as BridgeTransport};
 use super::columns::{Column, Columns3, Wavelengths};
@@ -13,6 +13,7 @@ use super::samples::Output;
 use super::spectrum::PlateSpectrum;
 use crate::error::{Error, Result};
 use crate::params::{Length, Thickness};
+use crate::render::choice::Choice;
 use crate::render::slots::{plate_component, PLATE_SLOTS};
 use crate::render::stack::{stack_lobes, StackQuery};
 use crate::stack::{in_layer, Layer, Stack};
@@ -31,7 +32,7 @@ pub fn sample_stack(
         spectrum.check_wavelength_columns(cols.wavelengths.count())?;
         let channels = spectrum.channels(cols.wavelengths.count());
         let mut output = Output::new(out, lanes.count, channels)?;
-        let lane = |i| stack_lane(materials, spectrum, call, &cols, i);
+        let lane = |i, lobes: &mut _| stack_lane(materials, spectrum, call, &cols, i, lobes);
         write_lanes(
             &mut output,
             lanes.count,
@@ -102,7 +103,8 @@ fn stack_lane(
     call: &PlateCall,
     cols: &StackColumns,
     i: usize,
-) -> Result<Sampled<PLATE_SLOTS>> {
+    lobes: &mut Lobes<PLATE_SLOTS>,
+) -> Result<Option<Choice>> {
     let (transport, u) = transport_and_sample(&cols.transport, &cols.sample, i)?;
     let layers = (0..cols.material.len())
         .map(|k| {
@@ -131,5 +133,5 @@ fn stack_lane(
     .with_absorbing_exit(call.absorbing_exit);
     let (s, pick) = spectrum.lane(cols.wavelengths.at(i), cols.wavelengths.count());
     let per_channel = stack_lobes(&q, &s, cols.wi.at(i), transport)?;
-    Ok(choose_thin(&per_channel, pick, call, u))
+    Ok(choose_thin(&per_channel, pick, call, u, lobes))
 }

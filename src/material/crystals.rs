@@ -16,8 +16,12 @@ use std::borrow::Cow;
 /// `n_e(λ)` (the index for light polarised along the optic axis).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Crystal {
-    /// Canonical lowercase name, e.g. `"calcite"`.
+    /// Canonical lowercase name, the one the docs, the plugins' `material` and the calculator
+    /// use, e.g. `"calcite"`, `"quartz"`, `"linbo3"`.
     pub name: &'static str,
+    /// What the crystal is called in full, e.g. `"lithium niobate"` (also an accepted name
+    /// unless it equals `name`).
+    pub long_name: &'static str,
     /// Other accepted names (lowercase).
     pub aliases: &'static [&'static str],
     /// Ordinary index `n_o(λ)`.
@@ -40,6 +44,16 @@ impl Crystal {
             self.ordinary.index(wavelength_nm),
             self.extraordinary.index(wavelength_nm),
         )
+    }
+
+    /// The name a message shows: `"linbo3 (lithium niobate)"`, or `"calcite"` when the name is
+    /// the full name.
+    pub fn label(&self) -> String {
+        if self.long_name == self.name {
+            self.name.to_string()
+        } else {
+            format!("{} ({})", self.name, self.long_name)
+        }
     }
 
     /// Birefringence `n_e − n_o` at `wavelength_nm` (positive for optically
@@ -90,6 +104,7 @@ const fn sellmeier(a: f64, terms: &'static [Term]) -> Dispersion {
 /// `n_e² = 1.35859695 + 0.82427830 λ²/(λ² − 1.06689543·10⁻²) + 0.14429128 λ²/(λ² − 120)`
 pub static CALCITE: Crystal = Crystal {
     name: "calcite",
+    long_name: "calcite",
     aliases: &["iceland spar", "caco3"],
     ordinary: sellmeier(
         1.73358749,
@@ -115,8 +130,9 @@ pub static CALCITE: Crystal = Crystal {
 ///
 /// (Optical activity of quartz along its axis is not modelled.)
 pub static QUARTZ: Crystal = Crystal {
-    name: "crystalline quartz",
-    aliases: &["quartz", "alpha-quartz", "crystal quartz"],
+    name: "quartz",
+    long_name: "crystalline quartz",
+    aliases: &["crystalline quartz", "alpha-quartz", "crystal quartz"],
     ordinary: sellmeier(
         1.28604141,
         &[osc(1.07044083, 1.00585997e-2), osc(1.10202242, 100.0)],
@@ -140,6 +156,7 @@ pub static QUARTZ: Crystal = Crystal {
 /// `n_e² − 1 = 1.5039759 λ²/(λ² − 0.0740288²) + 0.55069141 λ²/(λ² − 0.1216529²) + 6.5927379 λ²/(λ² − 20.072248²)`
 pub static SAPPHIRE: Crystal = Crystal {
     name: "sapphire",
+    long_name: "sapphire",
     aliases: &["corundum", "al2o3"],
     ordinary: sellmeier(
         1.0,
@@ -181,6 +198,7 @@ pub static SAPPHIRE: Crystal = Crystal {
 /// (with a warning, see [`crate::material::Material::coverage`]).
 pub static RUTILE: Crystal = Crystal {
     name: "rutile",
+    long_name: "rutile",
     aliases: &["tio2"],
     ordinary: sellmeier(5.913, &[pole(0.2441, 0.0803)]),
     extraordinary: sellmeier(7.197, &[pole(0.3322, 0.0843)]),
@@ -198,8 +216,9 @@ pub static RUTILE: Crystal = Crystal {
 ///
 /// `n_e² − 1 = 0.41344023 λ²/(λ² − 0.03684262²) + 0.50497499 λ²/(λ² − 0.09076162²) + 2.4904862 λ²/(λ² − 23.771995²)`
 pub static MAGNESIUM_FLUORIDE: Crystal = Crystal {
-    name: "magnesium fluoride",
-    aliases: &["mgf2"],
+    name: "mgf2",
+    long_name: "magnesium fluoride",
+    aliases: &["magnesium fluoride"],
     ordinary: sellmeier(
         1.0,
         &[
@@ -229,8 +248,9 @@ pub static MAGNESIUM_FLUORIDE: Crystal = Crystal {
 ///
 /// `n_e² − 1 = 2.9804 λ²/(λ² − 0.02047) + 0.5981 λ²/(λ² − 0.0666) + 8.9543 λ²/(λ² − 416.08)`
 pub static LITHIUM_NIOBATE: Crystal = Crystal {
-    name: "lithium niobate",
-    aliases: &["linbo3", "congruent lithium niobate"],
+    name: "linbo3",
+    long_name: "lithium niobate",
+    aliases: &["lithium niobate", "congruent lithium niobate"],
     ordinary: sellmeier(
         1.0,
         &[
@@ -262,8 +282,9 @@ pub static LITHIUM_NIOBATE: Crystal = Crystal {
 ///
 /// `n_e² = 2.3730 + 0.0128/(λ² − 0.0156) − 0.0044 λ²`
 pub static BETA_BARIUM_BORATE: Crystal = Crystal {
-    name: "beta barium borate",
-    aliases: &["bbo", "beta-bbo", "bab2o4"],
+    name: "bbo",
+    long_name: "beta barium borate",
+    aliases: &["beta barium borate", "beta-bbo", "bab2o4"],
     ordinary: sellmeier(
         2.7405,
         &[pole(0.0184, 0.0179), Term::Power { d: -0.0155, p: 2 }],
@@ -286,8 +307,9 @@ pub static BETA_BARIUM_BORATE: Crystal = Crystal {
 ///
 /// `n_e² = 2.132668 + 3.2279924 λ²/(λ² − 400) + 0.008637494/(λ² − 0.0122810)`
 pub static KDP: Crystal = Crystal {
-    name: "potassium dihydrogen phosphate",
-    aliases: &["kdp", "kh2po4"],
+    name: "kdp",
+    long_name: "potassium dihydrogen phosphate",
+    aliases: &["potassium dihydrogen phosphate", "kh2po4"],
     ordinary: sellmeier(
         2.259276,
         &[osc(13.00522, 400.0), pole(0.01008956, 0.0129426)],
@@ -336,6 +358,15 @@ pub fn crystal(name: &str) -> Option<&'static Crystal> {
 /// Canonical names of all catalogued crystals.
 pub fn crystal_names() -> Vec<&'static str> {
     CRYSTALS.iter().map(|c| c.name).collect()
+}
+
+/// Every catalogued crystal as a message lists it: `"calcite, quartz (crystalline quartz), …"`.
+pub fn crystal_list() -> String {
+    CRYSTALS
+        .iter()
+        .map(|c| c.label())
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// Mitsuba 3's named indices of refraction, exactly as in its `ior_data` table
@@ -461,7 +492,7 @@ mod tests {
 
     #[test]
     fn birefringence_signs() {
-        let positive = ["crystalline quartz", "rutile", "magnesium fluoride"];
+        let positive = ["quartz", "rutile", "mgf2"];
         for c in CRYSTALS {
             let b = c.birefringence(D_LINE);
             assert_eq!(b > 0.0, positive.contains(&c.name), "{}: Δn = {b}", c.name);
@@ -510,12 +541,9 @@ mod tests {
 
     #[test]
     fn lookup_names_and_aliases() {
+        // The names README.md, plugin/README.md and the calculator's docs use.
         let required = [
-            "calcite",
-            "crystalline quartz",
-            "sapphire",
-            "rutile",
-            "magnesium fluoride",
+            "calcite", "quartz", "sapphire", "rutile", "mgf2", "linbo3", "bbo", "kdp",
         ];
         let names = crystal_names();
         for r in required {
@@ -525,18 +553,21 @@ mod tests {
         let cases = [
             ("Calcite", "calcite"),
             ("  CALCITE\t", "calcite"),
-            ("quartz", "crystalline quartz"),
-            ("Alpha-Quartz", "crystalline quartz"),
-            ("alpha_quartz", "crystalline quartz"),
-            ("Crystalline  Quartz", "crystalline quartz"),
+            ("quartz", "quartz"),
+            ("Alpha-Quartz", "quartz"),
+            ("alpha_quartz", "quartz"),
+            ("Crystalline  Quartz", "quartz"),
             ("corundum", "sapphire"),
             ("Al2O3", "sapphire"),
             ("TiO2", "rutile"),
-            ("MgF2", "magnesium fluoride"),
-            ("magnesium-fluoride", "magnesium fluoride"),
-            ("LiNbO3", "lithium niobate"),
-            ("beta-BBO", "beta barium borate"),
-            ("KDP", "potassium dihydrogen phosphate"),
+            ("MgF2", "mgf2"),
+            ("magnesium-fluoride", "mgf2"),
+            ("LiNbO3", "linbo3"),
+            ("lithium niobate", "linbo3"),
+            ("beta-BBO", "bbo"),
+            ("beta barium borate", "bbo"),
+            ("KDP", "kdp"),
+            ("potassium dihydrogen phosphate", "kdp"),
         ];
         for (q, want) in cases {
             assert_eq!(crystal(q).map(|c| c.name), Some(want), "query {q:?}");
@@ -557,6 +588,8 @@ mod tests {
                 assert!(seen.insert(normalize(n)), "duplicate name {n}");
                 assert!(isotropic_ior(n).is_none(), "{n} is also isotropic");
             }
+            // The full name is accepted too (it is the name, or one of the aliases).
+            assert_eq!(crystal(c.long_name).map(|x| x.name), Some(c.name));
         }
     }
 

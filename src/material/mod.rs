@@ -97,8 +97,10 @@ impl Material {
             Error::new(
                 "material",
                 format!(
-                    "unknown crystal '{name}' (known: {})",
-                    crystals::crystal_names().join(", ")
+                    "unknown crystal '{name}'; the catalogue's names: {} (case and the \
+                     full names in brackets are accepted too), or give constant indices eta_o \
+                     and eta_e instead",
+                    crystals::crystal_list()
                 ),
             )
         })?;
@@ -185,7 +187,7 @@ impl Material {
                         "wavelength_nm",
                         format!(
                             "{at} outside the {a}-{b} nm range of the dispersion data for {} (extrapolated only within {r0}-{r1} nm, where Mitsuba samples)",
-                            c.name
+                            c.label()
                         ),
                     ));
                 }
@@ -201,7 +203,7 @@ impl Material {
                 };
                 warnings.push(format!(
                     "the dispersion data for {} cover {a}-{b} nm: its fit is extrapolated at {span}{note}",
-                    c.name
+                    c.label()
                 ));
             }
         }

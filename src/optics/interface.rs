@@ -235,7 +235,8 @@ fn carried(m: &Mode) -> f64 {
     }
 }
 
-fn singular() -> Error {
+/// The error of a singular boundary system.
+pub(crate) fn singular() -> Error {
     Error::new(
         "interface",
         "the boundary system is singular for this incidence (a guided or degenerate mode)",

@@ -165,7 +165,7 @@ impl Group {
 }
 
 /// The plane of incidence and `β` for a wave arriving from `towards_light`.
-fn incidence(
+pub(crate) fn incidence(
     surface: &Surface,
     towards_light: Vector3<f64>,
     incident: Incident,

@@ -3,6 +3,7 @@
 //! Mueller algebra of the light it scatters (eqs. S1-S19).
 
 pub mod admittance;
+pub mod clear_lobes;
 pub mod fields;
 pub mod frame;
 pub mod fresnel;
@@ -12,3 +13,4 @@ pub mod medium;
 pub mod modes;
 pub mod mueller;
 pub mod surface;
+pub mod uniaxial_fresnel;

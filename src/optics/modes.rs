@@ -144,12 +144,21 @@ pub fn modes(medium: &Uniaxial, beta: C64) -> ModeSet {
 /// isotropic medium), without the fields: the same roots and branches as [`modes`], at a
 /// fraction of its cost (for the phases of a layer whose amplitudes are known).
 pub fn normal_components(medium: &Uniaxial, beta: C64) -> [C64; 4] {
-    let (qo_up, qo_down) = up_down(cmath::sqrt(normal_squared(medium.eta_o, beta)));
     if medium.is_isotropic() {
+        let (qo_up, qo_down) = up_down(cmath::sqrt(normal_squared(medium.eta_o, beta)));
         return [qo_down, qo_down, qo_up, qo_up];
     }
-    let (qe_up, qe_down, _) = extraordinary_q_w(medium, beta);
-    [qo_down, qe_down, qo_up, qe_up]
+    uniaxial_normals(medium, beta).0
+}
+
+/// The normal components `[o↓, e↓, o↑, e↑]` of a (non-isotropic) uniaxial medium, as
+/// [`uniaxial_modes`] takes them, and the up-going e-wave's `w = a q⁺ + b = (εk)_z` (real
+/// when the e-wave propagates in a lossless medium: its exact flux, [`Fields::extraordinary`]).
+#[inline]
+pub(crate) fn uniaxial_normals(medium: &Uniaxial, beta: C64) -> ([C64; 4], C64) {
+    let (qo_up, qo_down) = up_down(cmath::sqrt(normal_squared(medium.eta_o, beta)));
+    let (qe_up, qe_down, w) = extraordinary_q_w(medium, beta);
+    ([qo_down, qe_down, qo_up, qe_up], w)
 }
 
 /// Picks the root pair `(−b ± w)/a` so that the first returned value is the up-going one,

@@ -44,6 +44,26 @@ pub fn from_jones(j: &Matrix2<C64>) -> Matrix4<f64> {
     m
 }
 
+/// [`from_jones`] of `[[a, b], [0, 0]]` (light leaving in the `x` state of its frame only, as a
+/// crystal wave does), written out: rows 0 and 1 are
+/// `(½(|a|² + |b|²), ½(|a|² − |b|²), Re(ā b), Im(ā b))`, rows 2 and 3 zero.
+pub fn from_jones_row(a: C64, b: C64) -> Matrix4<f64> {
+    let (p, r) = (a.norm_sqr(), b.norm_sqr());
+    let w = a.conj() * b;
+    let row = [0.5 * (p + r), 0.5 * (p - r), w.re, w.im];
+    Matrix4::from_fn(|i, j| if i < 2 { row[j] } else { 0.0 })
+}
+
+/// [`from_jones`] of `[[a, 0], [c, 0]]` (light arriving in the `x` state of its frame only, as a
+/// crystal wave does), written out: columns 0 and 1 are
+/// `(½(|a|² + |c|²), ½(|a|² − |c|²), Re(c̄ a), Im(c̄ a))`, columns 2 and 3 zero.
+pub fn from_jones_column(a: C64, c: C64) -> Matrix4<f64> {
+    let (p, q) = (a.norm_sqr(), c.norm_sqr());
+    let x = c.conj() * a;
+    let column = [0.5 * (p + q), 0.5 * (p - q), x.re, x.im];
+    Matrix4::from_fn(|i, j| if j < 2 { column[i] } else { 0.0 })
+}
+
 /// The coherency superoperator `K(J) = J_m ⊗ conj(J_m) = conj(J) ⊗ J`: it maps the vectorised
 /// coherency matrix (Mitsuba's convention) of the input to that of the output, and composes
 /// like the Jones matrices do (`K(J₁J₂) = K(J₁)K(J₂)`). Sums of `K` over incoherent paths and
@@ -116,6 +136,22 @@ pub fn reversed(m: &Matrix4<f64>) -> Matrix4<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The written-out rank-one forms equal the general one (same operations: exactly).
+    #[test]
+    fn row_and_column_forms_equal_from_jones() {
+        let mut next = crate::cmath::uniform(5);
+        let z = C64::new(0.0, 0.0);
+        for _ in 0..1000 {
+            let mut c = || C64::new(2.0 * next() - 1.0, 2.0 * next() - 1.0);
+            let (a, b) = (c(), c());
+            assert_eq!(from_jones_row(a, b), from_jones(&Matrix2::new(a, b, z, z)));
+            assert_eq!(
+                from_jones_column(a, b),
+                from_jones(&Matrix2::new(a, z, b, z))
+            );
+        }
+    }
 
     /// Mitsuba's coherency → Stokes matrix `A`.
     fn a_matrix() -> Matrix4<C64> {

@@ -8,7 +8,6 @@
 //! depend on `k` at fixed indices. Orders beyond the chosen `N` are summed incoherently in
 //! closed form ([`IncoherentTail`]).
 
-use crate::cmath;
 use crate::optics::mueller;
 use crate::plate::slab::{SlabBlocks, SlabOptics, Want};
 use nalgebra::{Matrix2, Matrix4};
@@ -56,104 +55,220 @@ pub struct PathExpansion {
     pub tail: IncoherentTail,
 }
 
-/// The internal waves of one stage of the expansion, by class and by the mode of their last
-/// traversal: cell `(i, j, m)` (`i` e traversals down, `j` up; `m` the mode, 0 = o, 1 = e)
-/// holds the row vector of that mode's amplitude per input polarisation (s, p). A reflection
-/// maps mode `m` to `m'` by the scalar `r[m'][m]`, so a stage needs only these row vectors.
-struct Stage {
-    cells: Vec<[C64; 2]>,
-    present: Vec<bool>,
-    cols: usize,
+/// The reflected or transmitted lobe of the slab.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Lobe {
+    /// Reflection: the direct top reflection (index 0), then the classes of each order.
+    Reflection,
+    /// Transmission.
+    Transmission,
 }
 
-/// Squared amplitude below which an internal path class is dropped.
+impl Lobe {
+    /// Both lobes, in the order of [`crate::plate::slab::SlabMueller`]'s fields.
+    pub const BOTH: [Lobe; 2] = [Lobe::Reflection, Lobe::Transmission];
+
+    /// The classes of orders `0..=order` (the direct reflection included).
+    pub fn classes(self, order: usize) -> usize {
+        let n = order + 1;
+        match self {
+            Lobe::Transmission => n * (n + 1) * (n + 2) / 3,
+            Lobe::Reflection => (n + 1) * (n + 2) * (2 * n + 3) / 6,
+        }
+    }
+
+    /// The index of class `(n, i, j)`: order `n`, `i` e-traversals down, `j` up (a fixed
+    /// layout: classes of lower orders first, then by `i` and `j`).
+    pub fn index(self, n: usize, i: usize, j: usize) -> usize {
+        match self {
+            Lobe::Transmission => Lobe::Transmission.classes_below(n) + i * (n + 1) + j,
+            Lobe::Reflection => Lobe::Reflection.classes_below(n) + i * (n + 2) + j,
+        }
+    }
+
+    /// Classes of orders below `n` (the direct reflection included).
+    fn classes_below(self, n: usize) -> usize {
+        match n {
+            0 => usize::from(self == Lobe::Reflection),
+            n => self.classes(n - 1),
+        }
+    }
+
+    /// The traversal counts `[o↓, e↓, o↑, e↑]` and the order of class `index`.
+    pub fn class(self, index: usize) -> (Counts, usize) {
+        if self == Lobe::Reflection && index == 0 {
+            return ([0; 4], 0);
+        }
+        let n = (0..).find(|&n| self.classes(n) > index).expect("an order");
+        let k = index - self.classes_below(n);
+        let (cols, ups) = match self {
+            Lobe::Transmission => (n + 1, n),
+            Lobe::Reflection => (n + 2, n + 1),
+        };
+        let (i, j) = (k / cols, k % cols);
+        let c = |x: usize| x as u16;
+        ([c(n + 1 - i), c(i), c(ups - j), c(j)], n)
+    }
+}
+
+/// The amplitudes of every path class of both lobes up to one order, in the layout of
+/// [`Lobe::index`], and the internal waves that enter the next order (for the incoherent tail):
+/// the expansion as a dynamic programme over the stages of the internal waves, by class and by
+/// the mode of their last traversal (a reflection maps mode `m` to `m'` by the scalar
+/// `r[m'][m]`, so a stage holds one row vector per cell: the amplitude per input polarisation).
+#[derive(Clone, Debug)]
+pub struct ClassAmplitudes {
+    /// Highest order the storage holds.
+    capacity: usize,
+    /// Highest order expanded by the last [`ClassAmplitudes::expand`].
+    pub order: usize,
+    /// Reflected classes ([`Lobe::Reflection`]'s layout).
+    pub reflection: Vec<Matrix2<C64>>,
+    /// Transmitted classes, flux factor included.
+    pub transmission: Vec<Matrix2<C64>>,
+    /// Per mode `m` of the waves entering the traversal after the last order,
+    /// `Σ_cells conj(v_c1) v_c2` as the vectorised-coherency row `2 c1 + c2`.
+    pub populations: [[C64; 4]; 2],
+    /// The same waves summed coherently (row `m`: mode `m`), for an isotropic layer.
+    pub state: Matrix2<C64>,
+    down: Vec<[C64; 2]>,
+    up: Vec<[C64; 2]>,
+}
+
+/// Squared amplitude below which an internal wave is dropped (amplitude < 1e-15 of the
+/// incident wave: it cannot matter).
 const NEGLIGIBLE: f64 = 1e-30;
 
-impl Stage {
-    fn new(rows: usize, cols: usize) -> Self {
-        Stage {
-            cells: vec![[C64::new(0.0, 0.0); 2]; rows * cols * 2],
-            present: vec![false; rows * cols * 2],
-            cols,
+impl ClassAmplitudes {
+    /// Storage for orders up to `capacity`.
+    pub fn with_capacity(capacity: usize) -> Self {
+        let stage = 2 * (capacity + 3) * (capacity + 3);
+        let zero = Matrix2::zeros();
+        ClassAmplitudes {
+            capacity,
+            order: 0,
+            reflection: vec![zero; Lobe::Reflection.classes(capacity)],
+            transmission: vec![zero; Lobe::Transmission.classes(capacity)],
+            populations: [[C64::new(0.0, 0.0); 4]; 2],
+            state: zero,
+            down: vec![[C64::new(0.0, 0.0); 2]; stage],
+            up: vec![[C64::new(0.0, 0.0); 2]; stage],
         }
     }
 
-    fn index(&self, i: usize, j: usize, m: usize) -> usize {
-        (i * self.cols + j) * 2 + m
+    /// The highest order the storage holds.
+    pub fn capacity(&self) -> usize {
+        self.capacity
     }
 
-    fn add(&mut self, i: usize, j: usize, m: usize, v: [C64; 2]) {
-        let k = self.index(i, j, m);
-        self.cells[k][0] += v[0];
-        self.cells[k][1] += v[1];
-        self.present[k] = true;
-    }
-
-    /// Every present cell as `(i, j, m, v)`.
-    fn iter(&self) -> impl Iterator<Item = (usize, usize, usize, &[C64; 2])> {
-        let cols = self.cols;
-        self.cells
-            .iter()
-            .zip(&self.present)
-            .enumerate()
-            .filter_map(move |(k, (v, p))| p.then_some(((k / 2) / cols, (k / 2) % cols, k % 2, v)))
-    }
-
-    /// The stage after a reflection `r` (mode `m` → `m'`) and the next traversal, down (the
-    /// first index counts e) or up (the second does).
-    fn reflect(&self, r: &Matrix2<C64>, down: bool) -> Stage {
-        let rows = self.cells.len() / (2 * self.cols);
-        let (rows, cols) = if down {
-            (rows + 1, self.cols)
-        } else {
-            (rows, self.cols + 1)
-        };
-        let mut out = Stage::new(rows, cols);
-        for (i, j, m, v) in self.iter() {
-            for to in 0..2 {
-                let w = [r[(to, m)] * v[0], r[(to, m)] * v[1]];
-                // Paths this weak cannot matter (amplitude < 1e-15 of the incident wave).
-                if w[0].norm_sqr() + w[1].norm_sqr() < NEGLIGIBLE {
-                    continue;
+    /// Expands the plate of `blocks` to `order` (at most the capacity) for the lobes of `want`.
+    pub fn expand(&mut self, b: &SlabBlocks, order: usize, want: Want) {
+        assert!(order <= self.capacity, "order {order} beyond the capacity");
+        self.order = order;
+        let zero = Matrix2::zeros();
+        if want.reflection {
+            self.reflection[..Lobe::Reflection.classes(order)].fill(zero);
+            self.reflection[0] = b.r1;
+        }
+        if want.transmission {
+            self.transmission[..Lobe::Transmission.classes(order)].fill(zero);
+        }
+        let ft = C64::new(b.flux.sqrt(), 0.0);
+        let one = C64::new(1.0, 0.0);
+        let z = [C64::new(0.0, 0.0); 2];
+        // Stage Dₙ (n + 1 traversals down, i of them e; n up, j of them e): cell
+        // (i (n + 1) + j) 2 + m.
+        self.down[..4].fill(z);
+        self.down[0] = [b.t1[(0, 0)], b.t1[(0, 1)]];
+        self.down[2 + 1] = [b.t1[(1, 0)], b.t1[(1, 1)]];
+        for n in 0..=order {
+            let (rows, cols, up_cols) = (n + 2, n + 1, n + 2);
+            let (t_base, r_base) = (
+                Lobe::Transmission.index(n, 0, 0),
+                Lobe::Reflection.index(n, 0, 0),
+            );
+            self.up[..2 * rows * up_cols].fill(z);
+            for i in 0..rows {
+                for j in 0..cols {
+                    for m in 0..2 {
+                        let v = self.down[2 * (i * cols + j) + m];
+                        if v[0].norm_sqr() + v[1].norm_sqr() < NEGLIGIBLE {
+                            continue;
+                        }
+                        if want.transmission {
+                            let a = &mut self.transmission[t_base + i * cols + j];
+                            add_outer(a, &b.t2, m, &v, ft);
+                        }
+                        // Uₙ: after the bottom reflection (n + 1 up, j of them e).
+                        for to in 0..2 {
+                            let r = b.r2[(to, m)];
+                            let u = &mut self.up[2 * (i * up_cols + j + to) + to];
+                            u[0] += r * v[0];
+                            u[1] += r * v[1];
+                        }
+                    }
                 }
-                let (di, dj) = if down { (to, 0) } else { (0, to) };
-                out.add(i + di, j + dj, to, w);
+            }
+            // Dₙ₊₁: after the top reflection.
+            let next_cols = n + 2;
+            self.down[..2 * (n + 3) * next_cols].fill(z);
+            for i in 0..rows {
+                for j in 0..up_cols {
+                    for m in 0..2 {
+                        let v = self.up[2 * (i * up_cols + j) + m];
+                        if v[0].norm_sqr() + v[1].norm_sqr() < NEGLIGIBLE {
+                            continue;
+                        }
+                        if want.reflection {
+                            let a = &mut self.reflection[r_base + i * up_cols + j];
+                            add_outer(a, &b.t3, m, &v, one);
+                        }
+                        for to in 0..2 {
+                            let r = b.r3[(to, m)];
+                            let d = &mut self.down[2 * ((i + to) * next_cols + j) + to];
+                            d[0] += r * v[0];
+                            d[1] += r * v[1];
+                        }
+                    }
+                }
             }
         }
-        out
-    }
-
-    /// The class amplitudes `Σ_m t[:, m] ⊗ v_m` (leaving through `t`, times `scale`) by class.
-    fn leave(&self, t: &Matrix2<C64>, scale: C64) -> Vec<(usize, usize, Matrix2<C64>)> {
-        let mut out: Vec<(usize, usize, Matrix2<C64>)> = Vec::new();
-        for (i, j, m, v) in self.iter() {
-            let a = Matrix2::new(
-                t[(0, m)] * v[0],
-                t[(0, m)] * v[1],
-                t[(1, m)] * v[0],
-                t[(1, m)] * v[1],
-            ) * scale;
-            match out.last_mut() {
-                Some(last) if last.0 == i && last.1 == j => last.2 += a,
-                _ => out.push((i, j, a)),
-            }
-        }
-        out
-    }
-
-    /// Per mode `m`, `Σ_cells conj(v_c1) v_c2` as the vectorised-coherency row `2 c1 + c2`:
-    /// the populations of the next traversal's modes, per input coherency.
-    fn populations(&self) -> [[C64; 4]; 2] {
-        let mut x = [[C64::new(0.0, 0.0); 4]; 2];
-        for (_, _, m, v) in self.iter() {
+        let cells = 2 * (order + 3) * (order + 2);
+        self.populations = [[C64::new(0.0, 0.0); 4]; 2];
+        self.state = zero;
+        for (cell, v) in self.down[..cells].iter().enumerate() {
+            let m = cell % 2;
             for c1 in 0..2 {
+                self.state[(m, c1)] += v[c1];
                 for c2 in 0..2 {
-                    x[m][2 * c1 + c2] += v[c1].conj() * v[c2];
+                    self.populations[m][2 * c1 + c2] += v[c1].conj() * v[c2];
                 }
             }
         }
-        x
     }
+
+    /// The incoherent tail of the orders after the expanded ones at `lambda_nm`
+    /// ([`IncoherentTail`]; `merged` for an isotropic layer, whose s and p share one phase).
+    pub fn tail(&self, b: &SlabBlocks, merged: bool, lambda_nm: f64, want: Want) -> IncoherentTail {
+        if merged {
+            IncoherentTail::merged(b, &self.state, lambda_nm, want)
+        } else {
+            IncoherentTail::new(b, &self.populations, lambda_nm, want)
+        }
+    }
+}
+
+/// `a += s · t[:, m] ⊗ v` (the class amplitude of waves in mode `m` leaving through `t`).
+#[inline]
+fn add_outer(a: &mut Matrix2<C64>, t: &Matrix2<C64>, m: usize, v: &[C64; 2], s: C64) {
+    if v[0] == C64::new(0.0, 0.0) && v[1] == C64::new(0.0, 0.0) {
+        return;
+    }
+    let (t0, t1) = (t[(0, m)] * s, t[(1, m)] * s);
+    a[(0, 0)] += t0 * v[0];
+    a[(0, 1)] += t0 * v[1];
+    a[(1, 0)] += t1 * v[0];
+    a[(1, 1)] += t1 * v[1];
 }
 
 impl PathExpansion {
@@ -165,7 +280,8 @@ impl PathExpansion {
     }
 
     /// Expands the plate of `blocks` to order `n_max`; `merged` for an isotropic layer (one
-    /// phase for s and p); the incoherent tail of the higher orders at `tail_at` (nm), or zero.
+    /// phase for s and p: the classes of an order are summed into one); the incoherent tail of
+    /// the higher orders at `tail_at` (nm), or zero.
     pub fn from_blocks(
         b: &SlabBlocks,
         merged: bool,
@@ -173,63 +289,49 @@ impl PathExpansion {
         want: Want,
         tail_at: Option<f64>,
     ) -> Self {
+        let mut c = ClassAmplitudes::with_capacity(n_max);
+        c.expand(b, n_max, want);
         let qs = [-b.q[0], -b.q[1], b.q[2], b.q[3]];
-        let ft = C64::new(b.flux.sqrt(), 0.0);
         let class = |counts: Counts, order: usize, amplitude: Matrix2<C64>| PathClass {
             counts,
             order,
             q: counts.iter().zip(qs).map(|(n, q)| q * f64::from(*n)).sum(),
             amplitude,
         };
-        // (n + 2)(n + 1) transmitted and (n + 2)² reflected classes at most per order n.
-        let most = (n_max + 3) * (n_max + 2) * (n_max + 1) / 3 + n_max + 2;
-        let mut reflection = Vec::with_capacity(if want.reflection { most } else { 0 });
-        let mut transmission = Vec::with_capacity(if want.transmission { most } else { 0 });
-        if want.reflection {
-            reflection.push(class([0; 4], 0, b.r1));
-        }
-        if merged {
-            let tail = Self::merged_classes(
-                b,
-                n_max,
-                want,
-                tail_at,
-                &mut reflection,
-                &mut transmission,
-                &class,
-            );
-            return PathExpansion {
-                reflection,
-                transmission,
-                order: n_max,
-                thickness_nm: b.thickness_nm,
-                tail,
-            };
-        }
-        // The first traversal down: mode m carries row m of t₁.
-        let mut down = Stage::new(2, 1);
-        down.add(0, 0, 0, [b.t1[(0, 0)], b.t1[(0, 1)]]);
-        down.add(1, 0, 1, [b.t1[(1, 0)], b.t1[(1, 1)]]);
-        for order in 0..=n_max {
-            let n = order as u16;
-            // `down`: n + 1 traversals down (i of them e), n up (j of them e).
-            if want.transmission {
-                for (i, j, a) in down.leave(&b.t2, ft) {
-                    let (i, j) = (i as u16, j as u16);
-                    transmission.push(class([n + 1 - i, i, n - j, j], order, a));
+        let list = |lobe: Lobe, amps: &[Matrix2<C64>]| -> Vec<PathClass> {
+            let all = amps[..lobe.classes(n_max)]
+                .iter()
+                .enumerate()
+                .map(|(k, a)| {
+                    let (counts, order) = lobe.class(k);
+                    class(counts, order, *a)
+                });
+            if !merged {
+                return all.filter(|p| p.amplitude != Matrix2::zeros()).collect();
+            }
+            // One class per order (and the direct reflection), all traversals counted as o.
+            let mut out: Vec<PathClass> = Vec::new();
+            for p in all {
+                let counts = [p.counts[0] + p.counts[1], 0, p.counts[2] + p.counts[3], 0];
+                match out.last_mut() {
+                    Some(last) if last.counts == counts => last.amplitude += p.amplitude,
+                    _ => out.push(class(counts, p.order, p.amplitude)),
                 }
             }
-            let up = down.reflect(&b.r2, false);
-            if want.reflection {
-                for (i, j, a) in up.leave(&b.t3, C64::new(1.0, 0.0)) {
-                    let (i, j) = (i as u16, j as u16);
-                    reflection.push(class([n + 1 - i, i, n + 1 - j, j], order, a));
-                }
-            }
-            down = up.reflect(&b.r3, true);
-        }
+            out
+        };
+        let reflection = if want.reflection {
+            list(Lobe::Reflection, &c.reflection)
+        } else {
+            Vec::new()
+        };
+        let transmission = if want.transmission {
+            list(Lobe::Transmission, &c.transmission)
+        } else {
+            Vec::new()
+        };
         let tail = match tail_at {
-            Some(lambda_nm) => IncoherentTail::new(b, &down.populations(), lambda_nm, want),
+            Some(lambda_nm) => c.tail(b, merged, lambda_nm, want),
             None => IncoherentTail {
                 r: Matrix4::zeros(),
                 t: Matrix4::zeros(),
@@ -241,44 +343,6 @@ impl PathExpansion {
             order: n_max,
             thickness_nm: b.thickness_nm,
             tail,
-        }
-    }
-
-    /// The classes of an isotropic (merged) layer: s and p share one phase, so each order is
-    /// one class, `t₂ (r₃ r₂)ⁿ t₁` (and `t₃ r₂ (r₃ r₂)ⁿ t₁` reflected); returns the tail.
-    #[allow(clippy::too_many_arguments)]
-    fn merged_classes(
-        b: &SlabBlocks,
-        n_max: usize,
-        want: Want,
-        tail_at: Option<f64>,
-        reflection: &mut Vec<PathClass>,
-        transmission: &mut Vec<PathClass>,
-        class: &dyn Fn(Counts, usize, Matrix2<C64>) -> PathClass,
-    ) -> IncoherentTail {
-        let ft = C64::new(b.flux.sqrt(), 0.0);
-        let mut state = b.t1; // just below the top, going down
-        for order in 0..=n_max {
-            let n = order as u16;
-            if want.transmission {
-                transmission.push(class(
-                    [n + 1, 0, n, 0],
-                    order,
-                    cmath::mul2(&b.t2, &state) * ft,
-                ));
-            }
-            let up = cmath::mul2(&b.r2, &state);
-            if want.reflection {
-                reflection.push(class([n + 1, 0, n + 1, 0], order, cmath::mul2(&b.t3, &up)));
-            }
-            state = cmath::mul2(&b.r3, &up);
-        }
-        match tail_at {
-            Some(lambda_nm) => IncoherentTail::merged(b, &state, lambda_nm, want),
-            None => IncoherentTail {
-                r: Matrix4::zeros(),
-                t: Matrix4::zeros(),
-            },
         }
     }
 
@@ -297,7 +361,7 @@ impl PathExpansion {
 impl IncoherentTail {
     /// The incoherent sum of every order after the expanded ones, as coherency
     /// superoperators: `X₀ = P̄↓ Σ_c K(A_c)` of the internal waves entering the next
-    /// traversal (`x0[m]`: the population row of mode `m`, see `Stage::populations`), one round
+    /// traversal (`x0[m]`: the population row of mode `m`, [`ClassAmplitudes::populations`]), one round
     /// trip `P̄↓ K(r₃) P̄↑ K(r₂)`, summed as `(I − RT)⁻¹`. `P̄` keeps only the populations of
     /// the o and e modes, which have different phases: the sum runs on the two populations
     /// (a 2x2 real round trip).

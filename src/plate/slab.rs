@@ -356,6 +356,12 @@ impl SlabBlocks {
         })
     }
 
+    /// The diagonals of the propagation matrices `(P↓, P↑)` at `lambda_nm` (attenuation
+    /// included for complex `q`).
+    pub fn propagation(&self, lambda_nm: f64) -> ([C64; 2], [C64; 2]) {
+        phase_factors(self.thickness_nm, lambda_nm, &self.q)
+    }
+
     /// All values as one array (blocks row by row, then `q`, then the flux).
     pub fn values(&self) -> [C64; BLOCK_VALUES] {
         let mut v = [C64::new(0.0, 0.0); BLOCK_VALUES];
@@ -368,6 +374,22 @@ impl SlabBlocks {
         v[24..28].copy_from_slice(&self.q);
         v[28] = C64::new(self.flux, 0.0);
         v
+    }
+
+    /// Value `e` of [`SlabBlocks::values`], without building the array.
+    #[inline]
+    pub fn value(&self, e: usize) -> C64 {
+        let block = |m: &Matrix2<C64>, k: usize| m[(k / 2, k % 2)];
+        match e {
+            0..=3 => block(&self.r1, e),
+            4..=7 => block(&self.t1, e - 4),
+            8..=11 => block(&self.r3, e - 8),
+            12..=15 => block(&self.t3, e - 12),
+            16..=19 => block(&self.r2, e - 16),
+            20..=23 => block(&self.t2, e - 20),
+            24..=27 => self.q[e - 24],
+            _ => C64::new(self.flux, 0.0),
+        }
     }
 
     /// The inverse of [`SlabBlocks::values`].

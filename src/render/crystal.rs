@@ -15,7 +15,8 @@
 //! weight: 47,000 for silver at normal incidence). [`opaque`] makes this decision.
 
 use crate::error::{Error, Result};
-use crate::optics::lobes::{scatter, Event, Lobe};
+use crate::optics::clear_lobes::{self, each_clear_lobe, Arrival};
+use crate::optics::lobes::{scatter, Lobe};
 use crate::optics::modes::ModeKind;
 use crate::optics::mueller::reversed;
 use crate::optics::surface::{Incident, Surface};
@@ -24,45 +25,20 @@ use crate::render::slots::{crystal_slot, Slots, CRYSTAL_SLOTS};
 use crate::render::{PathLobe, Transport};
 use nalgebra::Vector3;
 
-/// The forward events of light arriving along `−towards` (exterior, or each crystal mode that
-/// can travel there), with the incident crystal mode.
-fn forward_events(
-    surface: &Surface,
-    towards: Vector3<f64>,
-) -> Result<Vec<(Option<ModeKind>, Event)>> {
-    if towards.z > 0.0 {
-        return Ok(vec![(None, scatter(surface, towards, Incident::Outside)?)]);
-    }
-    let kinds: &[ModeKind] = if surface.crystal.is_isotropic() {
-        &[ModeKind::O]
-    } else {
-        &[ModeKind::O, ModeKind::E]
-    };
-    kinds
-        .iter()
-        .map(|&k| Ok((Some(k), scatter(surface, towards, Incident::Inside(k))?)))
-        .collect()
-}
-
-/// The outgoing lobes of an event whose incident crystal mode is `incident` (`None`: from
-/// the exterior), with their components: reflections are 0; a transmission is 1 or 2 by its
-/// crystal-side mode.
-fn outgoing(event: &Event, incident: Option<ModeKind>) -> impl Iterator<Item = (usize, Lobe)> + '_ {
-    let by_mode = |m: ModeKind| if m == ModeKind::E { 2 } else { 1 };
-    let reflected = event.reflected.iter().flatten().map(|l| (0, *l));
-    let transmitted = event
-        .transmitted
-        .iter()
-        .flatten()
-        .map(move |l| (by_mode(incident.unwrap_or(l.kind)), *l));
-    reflected.chain(transmitted)
+/// How a surface event is computed: the closed form of [`crate::optics::clear_lobes`] where it
+/// applies, or always the general interface solve (the reference).
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Solve {
+    Fastest,
+    General,
 }
 
 /// Lobes of a bulk crystal surface seen from `wi` (unit, local; `wi.z < 0` is inside). A
-/// lossless isotropic crystal takes the closed form of [`crate::render::isotropic`]. Absorbing
-/// anisotropic crystals are refused (an error naming `kappa_o` or `kappa_e`): their per-ray powers are not
-/// defined (see the error message); isotropic absorbing media (metals, lossy dielectrics) are
-/// opaque, with the reflection lobe alone (module documentation).
+/// lossless isotropic crystal takes the closed form of [`crate::render::isotropic`], a lossless
+/// birefringent one that of [`crate::optics::clear_lobes`]. Absorbing anisotropic crystals are
+/// refused (an error naming `kappa_o` or `kappa_e`): their per-ray powers are not defined (see
+/// the error message); isotropic absorbing media (metals, lossy dielectrics) are opaque, with
+/// the reflection lobe alone (module documentation).
 pub fn crystal_lobes(
     surface: &Surface,
     wi: Vector3<f64>,
@@ -72,11 +48,14 @@ pub fn crystal_lobes(
     let Some(wi) = checked_direction(wi)? else {
         return Ok(Vec::new());
     };
-    if let Some(lobes) = isotropic::crystal_lobes(surface, wi, transport) {
+    // At most six lobes (from inside: each crystal wave's two reflections and refraction).
+    let mut lobes = Vec::with_capacity(6);
+    if let Some((reflection, refraction)) = isotropic::crystal_lobes(surface, wi, transport) {
+        lobes.push(reflection);
+        lobes.extend(refraction);
         return Ok(lobes);
     }
-    let mut lobes = Vec::new();
-    each_lobe(surface, wi, transport, |_, l| lobes.push(l))?;
+    each_lobe(surface, wi, transport, Solve::Fastest, |_, l| lobes.push(l))?;
     Ok(lobes)
 }
 
@@ -105,8 +84,8 @@ fn checked_direction(wi: Vector3<f64>) -> Result<Option<Vector3<f64>>> {
     Ok((wi.z != 0.0).then(|| wi.normalize()))
 }
 
-/// [`crystal_lobes`] by the general computation (every case, isotropic ones included): the
-/// reference the isotropic fast path is tested against.
+/// [`crystal_lobes`] by the general computation (every case, isotropic and clear crystals
+/// included, through the interface's solve): the reference the fast paths are tested against.
 pub fn crystal_lobes_full(
     surface: &Surface,
     wi: Vector3<f64>,
@@ -116,7 +95,7 @@ pub fn crystal_lobes_full(
         return Ok(Vec::new());
     };
     let mut lobes = Vec::new();
-    each_lobe(surface, wi, transport, |_, l| lobes.push(l))?;
+    each_lobe(surface, wi, transport, Solve::General, |_, l| lobes.push(l))?;
     Ok(lobes)
 }
 
@@ -128,11 +107,23 @@ pub fn crystal_slots(
     transport: Transport,
 ) -> Result<Slots<CRYSTAL_SLOTS>> {
     let mut slots = [None; CRYSTAL_SLOTS];
+    fill_crystal_slots(surface, wi, transport, &mut slots)?;
+    Ok(slots)
+}
+
+/// [`crystal_slots`] written into `slots` (every slot is set).
+pub fn fill_crystal_slots(
+    surface: &Surface,
+    wi: Vector3<f64>,
+    transport: Transport,
+    slots: &mut Slots<CRYSTAL_SLOTS>,
+) -> Result<()> {
+    *slots = [None; CRYSTAL_SLOTS];
     refuse_absorbing_birefringence(surface)?;
     let Some(wi) = checked_direction(wi)? else {
-        return Ok(slots);
+        return Ok(());
     };
-    if let Some(lobes) = isotropic::crystal_lobes(surface, wi, transport) {
+    if let Some((reflection, refraction)) = isotropic::crystal_lobes(surface, wi, transport) {
         // Reflection (component 0) and refraction (1) of an isotropic crystal, whose rays
         // count as o-rays.
         let crystal = Some(ModeKind::O);
@@ -141,66 +132,111 @@ pub fn crystal_slots(
         } else {
             (None, crystal)
         };
-        for l in lobes {
-            let wo_end = if l.component == 0 { near } else { far };
-            slots[crystal_slot(near, wo_end)] = Some(l);
-        }
-        return Ok(slots);
+        slots[crystal_slot(near, near)] = Some(reflection);
+        slots[crystal_slot(near, far)] = refraction;
+        return Ok(());
     }
-    each_lobe(surface, wi, transport, |slot, l| slots[slot] = Some(l))?;
-    Ok(slots)
+    each_lobe(surface, wi, transport, Solve::Fastest, |slot, l| {
+        slots[slot] = Some(l)
+    })
 }
 
-/// Calls `f(slot, lobe)` for every lobe seen from `wi` (unit, `wi.z != 0`), by the general
-/// computation.
+/// Calls `f(slot, lobe)` for every lobe seen from `wi` (unit, `wi.z != 0`), each event computed
+/// as `solve` says.
 fn each_lobe(
     surface: &Surface,
     wi: Vector3<f64>,
     transport: Transport,
+    solve: Solve,
     mut f: impl FnMut(usize, PathLobe),
 ) -> Result<()> {
     let opaque = opaque(surface);
     if wi.z < 0.0 && opaque {
         return Ok(()); // no light inside an opaque bulk
     }
-    for (inc, event) in forward_events(surface, wi)? {
-        for (component, l) in outgoing(&event, inc) {
-            if opaque && component != 0 {
-                continue; // refracted into the opaque bulk: absorbed at the surface
+    let clear = solve == Solve::Fastest && clear_lobes::applies(surface);
+    // The lobes of light arriving as the crystal wave `mode` (`None`: from the exterior).
+    let mut event = |mode: Option<ModeKind>| -> Result<()> {
+        let incident = mode.map_or(Incident::Outside, Incident::Inside);
+        let mut out = |arrival: &Arrival, reflected: bool, l: &Lobe| {
+            if let Some((slot, lobe)) = path_lobe(arrival, mode, reflected, l, opaque, transport) {
+                f(slot, lobe);
             }
-            // The crystal mode of the outgoing wave (None outside): a reflection stays on the
-            // incident side; a transmission from outside enters as its own mode.
-            let mode = match (component, inc) {
-                (0, inc) => inc.map(|_| l.kind),
-                (_, None) => Some(l.kind),
-                (_, Some(_)) => None,
+        };
+        if clear {
+            each_clear_lobe(surface, wi, incident, out)?;
+        } else {
+            let e = scatter(surface, wi, incident)?;
+            let arrival = Arrival {
+                direction: e.incident_direction,
+                stokes_x: e.incident_stokes_x,
+                ray_index: e.incident_ray_index,
             };
-            let slot = crystal_slot(inc, mode);
-            match transport {
-                Transport::Importance => f(
-                    slot,
-                    PathLobe::new(
-                        component,
-                        l.direction,
-                        (event.incident_stokes_x, l.stokes_x),
-                        l.mueller,
-                        l.ray_index / event.incident_ray_index,
-                    ),
-                ),
-                Transport::Radiance => f(
-                    slot,
-                    PathLobe::new(
-                        component,
-                        l.direction,
-                        (l.stokes_x, event.incident_stokes_x),
-                        reversed(&l.mueller) * (event.incident_ray_index / l.ray_index).powi(2),
-                        l.ray_index / event.incident_ray_index,
-                    ),
-                ),
+            for l in e.reflected.iter().flatten() {
+                out(&arrival, true, l);
+            }
+            for l in e.transmitted.iter().flatten() {
+                out(&arrival, false, l);
             }
         }
+        Ok(())
+    };
+    if wi.z > 0.0 {
+        return event(None);
+    }
+    // Light arrives from inside along each crystal wave that can travel there.
+    event(Some(ModeKind::O))?;
+    if !surface.crystal.is_isotropic() {
+        event(Some(ModeKind::E))?;
     }
     Ok(())
+}
+
+/// The slot and the lobe a path tracer samples for the outgoing wave `l` of light arriving as
+/// `arrival` in the crystal mode `incident` (`None`: from the exterior): a reflection is
+/// component 0, a transmission 1 or 2 by its crystal-side mode; `None` for a refraction into an
+/// `opaque` bulk (absorbed at the surface).
+fn path_lobe(
+    arrival: &Arrival,
+    incident: Option<ModeKind>,
+    reflected: bool,
+    l: &Lobe,
+    opaque: bool,
+    transport: Transport,
+) -> Option<(usize, PathLobe)> {
+    let component = match (reflected, incident.unwrap_or(l.kind)) {
+        (true, _) => 0,
+        (false, ModeKind::E) => 2,
+        (false, _) => 1,
+    };
+    if opaque && component != 0 {
+        return None;
+    }
+    // The crystal mode of the outgoing wave (None outside): a reflection stays on the incident
+    // side; a transmission from outside enters as its own mode.
+    let mode = match (reflected, incident) {
+        (true, inc) => inc.map(|_| l.kind),
+        (false, None) => Some(l.kind),
+        (false, Some(_)) => None,
+    };
+    let ratio = l.ray_index / arrival.ray_index;
+    let lobe = match transport {
+        Transport::Importance => PathLobe::new(
+            component,
+            l.direction,
+            (arrival.stokes_x, l.stokes_x),
+            l.mueller,
+            ratio,
+        ),
+        Transport::Radiance => PathLobe::new(
+            component,
+            l.direction,
+            (l.stokes_x, arrival.stokes_x),
+            reversed(&l.mueller) * (arrival.ray_index / l.ray_index).powi(2),
+            ratio,
+        ),
+    };
+    Some((crystal_slot(incident, mode), lobe))
 }
 
 /// Whether the crystal's bulk is opaque (any absorption): light refracted into it is absorbed

@@ -19,13 +19,14 @@ use crate::render::{PathLobe, Transport};
 use nalgebra::Vector3;
 use num_complex::Complex64 as C64;
 
-/// The lobes seen from `wi` (unit, local, `wi.z ≠ 0`), or `None` if the fast path does not
-/// apply (an anisotropic or absorbing crystal).
+/// The lobes seen from `wi` (unit, local, `wi.z ≠ 0`): the reflection (component 0) and, unless
+/// it is totally reflected, the refraction (component 1); `None` if the fast path does not apply
+/// (an anisotropic or absorbing crystal).
 pub fn crystal_lobes(
     surface: &Surface,
     wi: Vector3<f64>,
     transport: Transport,
-) -> Option<Vec<PathLobe>> {
+) -> Option<(PathLobe, Option<PathLobe>)> {
     let crystal = surface.crystal.eta_o;
     if !surface.crystal.is_isotropic() || crystal.im != 0.0 {
         return None;
@@ -43,19 +44,18 @@ pub fn crystal_lobes(
     } else {
         (f.r_below, f.t_below)
     };
-    let mut lobes = Vec::with_capacity(2);
     let reflected = Vector3::new(-wi.x, -wi.y, wi.z);
-    lobes.push(lobe(0, wi, reflected, r, 1.0, transport));
+    let reflection = lobe(0, wi, reflected, r, 1.0, transport);
     let ratio = near.re / far.re;
     let sin2 = ratio * ratio * (wi.x * wi.x + wi.y * wi.y);
-    if sin2 < 1.0 {
+    let refraction = (sin2 < 1.0).then(|| {
         let cos = (1.0 - sin2).sqrt();
         let wo = Vector3::new(-wi.x * ratio, -wi.y * ratio, -wi.z.signum() * cos);
         let flux = (normal_component(far, beta).re / normal_component(near, beta).re).sqrt();
         let tau = [t[0] * flux, t[1] * flux];
-        lobes.push(lobe(1, wi, wo, tau, far.re / near.re, transport));
-    }
-    Some(lobes)
+        lobe(1, wi, wo, tau, far.re / near.re, transport)
+    });
+    Some((reflection, refraction))
 }
 
 /// One lobe with flux-normalised s/p amplitudes `a`; `n_ratio = n_wo / n_wi`.

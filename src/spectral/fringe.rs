@@ -49,6 +49,8 @@ pub struct FringeRule {
     rows: usize,
     /// `max_c |Σ_i W_ic(G)|` (the visibility of a fringe of constant amplitude) per row.
     visibility: Vec<f64>,
+    /// The largest visibility at this row or beyond (a bound for every `|G'| ≥ G`).
+    beyond: Vec<f64>,
 }
 
 /// Centre and half width (rad/nm) of [`BAND_NM`] in wavenumber.
@@ -108,11 +110,16 @@ impl FringeRule {
                 visibility[m] = f64::max(visibility[m], total.norm());
             }
         }
+        let mut beyond = visibility.clone();
+        for m in (0..rows.saturating_sub(1)).rev() {
+            beyond[m] = beyond[m].max(beyond[m + 1]);
+        }
         FringeRule {
             nodes: x.iter().map(|t| k0 + a * t).collect(),
             table,
             rows,
             visibility,
+            beyond,
         }
     }
 
@@ -137,17 +144,34 @@ impl FringeRule {
         }
     }
 
+    /// The largest visibility of any fringe with `|G'| ≥ |G|` (a monotone bound of
+    /// [`FringeRule::visibility`], from the table row at or below `|G|`).
+    pub fn visibility_beyond(&self, g: f64) -> f64 {
+        let m = (g.abs() * (1.0 / STEP_NM)).floor();
+        if m.is_nan() || m >= (self.rows - 2) as f64 {
+            0.0
+        } else {
+            self.beyond[m as usize]
+        }
+    }
+
     /// The weights `W_ic(G)` into `out[i][c]` (zero beyond [`FringeRule::reach`]).
     pub fn weights(&self, g: f64, out: &mut [[C64; 3]]) {
+        for (i, o) in out.iter_mut().take(self.nodes.len()).enumerate() {
+            *o = self.weight(g, i);
+        }
+    }
+
+    /// The weights `W_ic(G)` of node `i` (zero beyond [`FringeRule::reach`]): cubic
+    /// interpolation between the table's rows.
+    pub fn weight(&self, g: f64, i: usize) -> [C64; 3] {
         let n = self.nodes.len();
         let s = g.abs() / STEP_NM;
-        let m = s.floor() as usize;
-        out[..n]
-            .iter_mut()
-            .for_each(|o| *o = [C64::new(0.0, 0.0); 3]);
-        if m + 2 >= self.rows {
-            return;
+        let mut out = [C64::new(0.0, 0.0); 3];
+        if s.is_nan() || s >= (self.rows - 2) as f64 {
+            return out;
         }
+        let m = s.floor() as usize;
         let t = s - m as f64;
         // Cubic Lagrange weights on rows m − 1 .. m + 2.
         let l = [
@@ -162,17 +186,15 @@ impl FringeRule {
                 Some(row) => (row, false),
                 None => (1, true),
             };
-            for (o, w) in out.iter_mut().zip(&self.table[row * n..row * n + n]) {
-                for c in 0..3 {
-                    o[c] += if flip { w[c].conj() } else { w[c] } * lr;
-                }
+            let w = &self.table[row * n + i];
+            for c in 0..3 {
+                out[c] += if flip { w[c].conj() } else { w[c] } * lr;
             }
         }
         if g < 0.0 {
-            out[..n]
-                .iter_mut()
-                .for_each(|o| o.iter_mut().for_each(|v| *v = v.conj()));
+            out.iter_mut().for_each(|v| *v = v.conj());
         }
+        out
     }
 }
 

@@ -18,8 +18,13 @@ use crate::optics::frame::PlaneFrame;
 use crate::plate::etalon::Etalon;
 use crate::plate::slab::{Output, SlabMueller, SlabOptics, Want};
 use crate::plate::Plate;
-use crate::spectral::channels;
+use crate::spectral::classes;
+use crate::spectral::dense;
+use crate::spectral::envelope;
 use crate::spectral::integrate::{etalon_sum, integrate, integrate_set_exact};
+use crate::spectral::route::{self, Route};
+use crate::spectral::shared;
+use crate::spectral::survey::Survey;
 use crate::spectral::weights::{gaussians, WeightSet};
 use num_complex::Complex64 as C64;
 use std::cell::OnceCell;
@@ -119,13 +124,23 @@ impl<'a> PlateModel<'a> {
             let mut one = |c: usize| self.band(gaussians(set, c), want, output, &mut incoherent);
             return Ok([one(0)?, one(1)?, one(2)?]);
         }
-        if accuracy == Accuracy::Perceptual {
-            if let Some(m) =
-                channels::channels(self.plate, &self.frame, self.beta, set, want, output)?
-            {
-                return Ok(m);
-            }
+        if accuracy == Accuracy::Exact {
+            return integrate_set_exact(self.plate, &self.frame, self.beta, set, want, output);
         }
-        integrate_set_exact(self.plate, &self.frame, self.beta, set, want, output)
+        let survey = Survey::new(self.plate, self.frame, self.beta)?;
+        match route::choose(&survey, set)? {
+            Route::Evanescent(points) => shared::quadrature(
+                self.plate,
+                &self.frame,
+                self.beta,
+                set,
+                points,
+                want,
+                output,
+            ),
+            Route::Dense(points) => dense::integrate(&survey, points, set, want, output),
+            Route::Envelope(plan) => envelope::integrate(&survey, &plan, set, want, output),
+            Route::Classes(plan) => classes::integrate(&survey, &plan, set, want, output),
+        }
     }
 }

@@ -8,7 +8,12 @@ use num_complex::Complex64 as C64;
 use std::sync::OnceLock;
 
 /// Node counts of the nested levels.
-pub const LEVELS: [usize; 5] = [1, 3, 5, 9, 17];
+pub const LEVELS: [usize; 6] = [1, 3, 5, 9, 17, 33];
+/// Where across the band (`t`) a plate's group paths are sampled
+/// ([`crate::spectral::survey`]): both ends, the centre and half-way (with normal dispersion they
+/// vary monotonically, with one curvature).
+pub const SPAN: [f64; 5] = [-1.0, -0.5, 0.0, 0.5, 1.0];
+
 /// The finest level's index.
 pub const FINEST: usize = LEVELS.len() - 1;
 /// Most nodes of any level.
@@ -77,6 +82,9 @@ pub struct Level {
     pub to_finest: Vec<Vec<f64>>,
     /// `slope[i]`: the derivative at `t = 0` of the Lagrange basis (zero for one node).
     pub slope: Vec<f64>,
+    /// `span_slopes[s][i]`: the derivative of the Lagrange basis at `SPAN[s]` (zero for one
+    /// node).
+    pub span_slopes: [Vec<f64>; SPAN.len()],
     /// `dct[m][i]`: the Chebyshev coefficient `c_m` of the interpolant per unit value at node
     /// `i` (`(2 − δ)/(n − 1) · w_i cos(π m i/(n − 1))`, `w_i` halved at both ends and `δ` for
     /// `m = 0, n − 1`; [`chebyshev`]).
@@ -115,6 +123,13 @@ impl Level {
             // L_i(ih) = L_i(0) + ih L_i'(0) − h² L_i''(0)/2 − ...: the imaginary part over h.
             basis.iter().map(|b| b.im / h).collect()
         };
+        let span_slopes = SPAN.map(|t| {
+            if n == 1 {
+                return vec![0.0];
+            }
+            lagrange(&nodes, C64::new(t, h), &mut basis);
+            basis.iter().map(|b| b.im / h).collect()
+        });
         let last = n.saturating_sub(1).max(1);
         let dct = (0..n)
             .map(|m| {
@@ -132,6 +147,7 @@ impl Level {
             in_finest,
             to_finest,
             slope,
+            span_slopes,
             dct,
         }
     }
@@ -249,6 +265,18 @@ mod tests {
             }
             let d: f64 = lv.nodes.iter().zip(&lv.slope).map(|(&x, w)| p(x) * w).sum();
             assert!((d - dp0).abs() < 1e-12, "level {l}: slope {d}");
+            for (t, w) in SPAN.iter().zip(&lv.span_slopes) {
+                let dp = |t: f64| {
+                    (1..n)
+                        .map(|m| m as f64 * (0.3 + m as f64) * t.powi(m as i32 - 1))
+                        .sum::<f64>()
+                };
+                let d: f64 = lv.nodes.iter().zip(w).map(|(&x, w)| p(x) * w).sum();
+                assert!(
+                    (d - dp(*t)).abs() < 1e-9 * (1.0 + dp(*t).abs()),
+                    "level {l} at {t}: {d}"
+                );
+            }
         }
     }
 }

@@ -40,6 +40,7 @@ use crate::plate::Plate;
 use crate::spectral::group::{dispersion, group_round_trips, group_splitting};
 use crate::spectral::hermite;
 use crate::spectral::interpolate::BlockInterpolant;
+use crate::spectral::nodes::{self, LEVELS, MAX_NODES};
 use crate::spectral::weights::{gaussians, WeightSet};
 use nalgebra::Matrix4;
 use num_complex::Complex64 as C64;
@@ -132,6 +133,35 @@ impl Rule {
             })
             .collect()
     }
+}
+
+/// The Lagrange basis of the nodes of `level` ([`crate::spectral::nodes`], on the visible band
+/// of [`crate::spectral::fringe::band`]) at every point of the rule of `set` with `points`
+/// points (rounded up to a rung of [`LADDER`]): `basis[j][i]` for point `j` and node `i`,
+/// computed once.
+pub fn node_basis(set: WeightSet, points: usize, level: usize) -> &'static [[f64; MAX_NODES]] {
+    const SETS: usize = WeightSet::ALL.len();
+    type Basis = OnceLock<Vec<[f64; MAX_NODES]>>;
+    static BASES: [[[Basis; LEVELS.len()]; LADDER.len()]; SETS] =
+        [const { [const { [const { OnceLock::new() }; LEVELS.len()] }; LADDER.len()] }; SETS];
+    let rung = LADDER
+        .iter()
+        .position(|&r| r >= points)
+        .unwrap_or(LADDER.len() - 1);
+    let level = level.min(LEVELS.len() - 1);
+    BASES[set.index()][rung][level].get_or_init(|| {
+        let (k0, a) = crate::spectral::fringe::band();
+        let x = &nodes::level(level).nodes;
+        let mut basis = [C64::new(0.0, 0.0); MAX_NODES];
+        rule(set, points)
+            .nodes
+            .iter()
+            .map(|&(k, _)| {
+                nodes::lagrange(x, C64::new((k - k0) / a, 0.0), &mut basis);
+                std::array::from_fn(|i| if i < x.len() { basis[i].re } else { 0.0 })
+            })
+            .collect()
+    })
 }
 
 /// The support `[lo, hi]` of a weight set: every Gaussian's `μ ± 6σ`.

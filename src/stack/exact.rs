@@ -105,7 +105,10 @@ pub fn layer_q_into(
     q: &mut [[C64; 4]],
 ) -> Result<()> {
     for (j, (l, qj)) in stack.layers.iter().zip(q.iter_mut()).enumerate() {
-        *qj = normal_components(&l.medium(lambda_nm, frame).map_err(|e| in_layer(j, e))?, beta);
+        *qj = normal_components(
+            &l.medium(lambda_nm, frame).map_err(|e| in_layer(j, e))?,
+            beta,
+        );
     }
     Ok(())
 }
@@ -126,7 +129,10 @@ impl StackBlocks {
         let mut iface = Interface::unsolved(top, top);
         for j in 0..=n {
             let below = match stack.layers.get(j) {
-                Some(l) => modes(&l.medium(lambda_nm, frame).map_err(|e| in_layer(j, e))?, beta),
+                Some(l) => modes(
+                    &l.medium(lambda_nm, frame).map_err(|e| in_layer(j, e))?,
+                    beta,
+                ),
                 None => modes(&Uniaxial::isotropic(stack.exit)?, beta),
             };
             iface.upper = iface.lower;

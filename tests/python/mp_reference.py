@@ -24,7 +24,7 @@ Derived from Maxwell's equations, not from the core's code:
 
 Exterior waves use the basis ``E_s = y``, ``E_p = k_hat x y`` of the working frame (z = normal
 towards the exterior, x = tangential direction of the wave vector, y = z x x), the convention
-stated in README.md. The local frame of the calculator is mapped to this working frame with the
+stated in docs/calculator.md. The local frame of the calculator is mapped to this working frame with the
 calculator's documented azimuth convention: the direction towards the light is
 ``(sin t cos phi, sin t sin phi, +-cos t)``, so ``x = -(cos phi, sin phi, 0)``.
 """

@@ -178,6 +178,67 @@ def test_an_rgb_bitmap_becomes_its_channel_image():
     assert pass_of({"type": "scene", "t": one})["t"] is one  # the same in every channel
 
 
+#: An 8-bit colour texture (rows, columns, RGB): a mid grey (128: 0.502 as stored, 0.2159 in
+#: linear sRGB) and three colours.
+EIGHT_BIT = np.array([[[128, 128, 128], [200, 30, 90]], [[10, 220, 40], [250, 250, 5]]],
+                     dtype=np.uint8)
+
+
+def srgb_to_linear(c: np.ndarray) -> np.ndarray:
+    """The sRGB transfer function (IEC 61966-2-1), written out."""
+    return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+
+
+@pytest.fixture
+def eight_bit_png(tmp_path) -> pathlib.Path:
+    """EIGHT_BIT written as a PNG: an 8-bit sRGB file, as a user's colour texture."""
+    variant("scalar_rgb")
+    path = tmp_path / "colours.png"
+    mi.Bitmap(EIGHT_BIT).write(str(path))
+    assert mi.Bitmap(str(path)).srgb_gamma()  # Mitsuba reads an 8-bit PNG as sRGB-encoded
+    return path
+
+
+@pytest.mark.parametrize("raw", [False, True])
+def test_an_8bit_srgb_bitmap_is_linearised_unless_raw(eight_bit_png, raw):
+    """An 8-bit sRGB texture becomes its linear values' channel values (grey 128: 0.2159); with
+    raw = true the stored values are taken as they are (0.502), in every pass of every set."""
+    node = {"type": "bitmap", "filename": str(eight_bit_png), "raw": raw}
+    stored = EIGHT_BIT / 255.0
+    linear = stored if raw else srgb_to_linear(stored)
+    for weights in SETS:
+        rows = np.linalg.inv(np.array(channel_matrix(weights)))
+        for k in range(3):
+            out = pass_of({"type": "scene", "s": {"type": "diffuse", "reflectance": node}},
+                          weights, k)
+            got = np.array(out["s"]["reflectance"]["bitmap"], dtype=np.float64)[..., 0]
+            np.testing.assert_allclose(got, linear @ rows[k], atol=1e-6, err_msg=f"{weights} {k}")
+    assert abs(linear[0, 0, 0] - (0.502 if raw else 0.2159)) < 1e-3
+
+
+@pytest.mark.parametrize("raw", [False, True])
+def test_an_8bit_textured_light_renders_its_colours(eight_bit_png, raw):
+    """A 2 x 2 image of an area light textured with the 8-bit file (nearest texels, one per
+    pixel) is the texture's linear colours, as Mitsuba's own scalar_rgb renders them (the grey
+    texel 0.2159, or 0.502 if raw), to float32 rounding of the channel passes."""
+    from _common import layer, ortho_sensor
+
+    def textured_light() -> dict:
+        light = layer(0.0, 1, 1, {"type": "diffuse"})
+        light["emitter"] = {"type": "area", "radiance": {
+            "type": "bitmap", "filename": str(eight_bit_png), "raw": raw, "filter_type": "nearest"}}
+        return {"type": "scene", "integrator": {"type": "path"},
+                "sensor": ortho_sensor(2, 2, 4, 1.0, 1.0), "light": light}
+
+    variant("scalar_rgb")
+    want = np.array(mi.render(mi.load_dict(textured_light())), dtype=np.float64)
+    variant("scalar_spectral_polarized")
+    got = mb.render_analytic(textured_light(), spp=4)["rgb"]
+    grey = 0.502 if raw else 0.2159
+    assert np.any(np.abs(want - grey).max(axis=-1) < 1e-3)  # one pixel sees the grey texel
+    np.testing.assert_allclose(got, want, atol=1e-4)
+
+
 @pytest.mark.parametrize("weights,emitter,message", [
     ("srgb-d65", {"type": "blackbody", "temperature": 3000}, "cannot be split"),
     ("srgb-d65", {"type": "uniform", "value": 1.0}, "equal-energy"),

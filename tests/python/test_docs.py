@@ -140,3 +140,21 @@ Prose that is not a parameter.
         "float or texture", "Indices of `the` plate, continued.", "`false`",
         "exposed, differentiable")
     assert params[1].default == "—" and params[1].flags == ""
+
+
+def test_benchmark_page_and_summary_are_generated_from_the_results(tmp_path):
+    """docs/benchmarks.md's tables and README.md's summary of them are what bench/readme.py
+    writes from bench/results.json (regenerate them after a benchmark: make bench-scenes or
+    make bench-overhead do)."""
+    page, readme = tmp_path / "benchmarks.md", tmp_path / "README.md"
+    page.write_text((DOCS / "benchmarks.md").read_text())
+    readme.write_text((ROOT / "README.md").read_text())
+    result = subprocess.run([sys.executable, str(ROOT / "bench" / "readme.py"),
+                             str(ROOT / "bench" / "results.json"), str(page), str(readme)],
+                            capture_output=True, text=True)
+    assert result.returncode == 0, result.stdout + result.stderr
+    # The page links to the repository's files relative to its own folder: from tmp_path that
+    # path differs, and is put back as from docs/.
+    written = re.sub(r"\]\([^)\s]*?bench/", "](../bench/", page.read_text())
+    assert written == (DOCS / "benchmarks.md").read_text()
+    assert readme.read_text() == (ROOT / "README.md").read_text()

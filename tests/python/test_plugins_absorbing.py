@@ -32,13 +32,17 @@ from test_scene_vs_mitsuba import THRESHOLD, max_z, renders
 
 # eta + i kappa. Conductors: silver (the index of the defect report), a gold-like index, and
 # kappa = 1 on the smallest real part the plugins accept (eta 0 itself is refused at load:
-# indices need a real part in [1e-3, 1e3]); lossy dielectrics.
+# indices need a real part in [1e-3, 1e3]); lossy dielectrics, down to kappa 1e-9: any
+# absorption makes the bulk opaque (a tolerance there, e.g. opaque only above 1e-2, refracted
+# most samples of kappa 1e-3 into the bulk and gained energy from inside).
 ABSORBING = {
     "silver": (0.136125, 4.010625),
     "gold-like": (0.18, 3.1),
     "0.001+1i": (1e-3, 1.0),
     "1.5+1i": (1.5, 1.0),
     "0.5+1i": (0.5, 1.0),
+    "1.5+1e-3i": (1.5, 1e-3),
+    "1.5+1e-9i": (1.5, 1e-9),
 }
 VARIANTS = ["scalar_rgb", POLARIZED]
 N_DIRECTIONS = 300

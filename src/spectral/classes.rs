@@ -1,0 +1,670 @@
+//! The plate over the channels of a weight set, pair of path classes by pair (the paper's
+//! closed form, with amplitudes interpolated across the band): the method for plates whose
+//! o and e waves drift apart faster than any node level follows (thick, strongly birefringent
+//! plates), where each fringe must be integrated exactly.
+//!
+//! Each Jones matrix is a sum over path classes `J(k) = Σ_c A_c(k) e^{ik d Q_c(k)}`
+//! ([`crate::plate::paths`]); the coherency's pairs of classes are grouped by what their
+//! spectral factor depends on ([`crate::spectral::layout`]). A group oscillates as
+//! `e^{iφ_Δ(k)}` around its group path `G_Δ = φ_Δ'(k₀)` and integrates against every channel
+//! by the fringe rules of [`crate::spectral::fringe`]:
+//!
+//! ```text
+//! ∫ w_c(k) K_Δ(k) dk = e^{iφ_Δ(k₀)} Σ_p P_Δ(k_p) W_pc(G_Δ),
+//! P_Δ(k) = Σ_(a,b) cross(A_a, A_b)(k) e^{−kd Im(Q_a + Q_b)} e^{i(φ_Δ(k) − φ_Δ(k₀) − G_Δ (k − k₀))}
+//! ```
+//! `P_Δ` is smooth (amplitudes, absorption and the residual curvature of the phase): its
+//! amplitudes come from the exact blocks at the nodes of one level ([`Amplitudes`]; coarser for
+//! weaker groups), interpolated to its phase nodes, where its phase and attenuation are exact.
+//! Every node's share is a scalar per channel, `ω_ic = Σ_p factor_p W_pc L_i(k_p)`, so the pairs
+//! are summed once per amplitude node. A group whose residual phase no level resolves (strong
+//! dispersion in thick plates) takes a shared product-integration rule of as many points as its
+//! chirp needs ([`Integration::dense`]). Groups whose fringe is invisible in every channel are dropped; orders
+//! beyond the coherent ones are the incoherent tail of [`crate::plate::paths`]. The budget of
+//! every approximation: [`crate::spectral::budget`].
+
+use crate::error::Result;
+use crate::optics::mueller;
+use crate::plate::paths::{ClassAmplitudes, Lobe};
+use crate::plate::slab::{Output, SlabMueller, Want};
+use crate::scratch::{Pool, Pooled};
+use crate::spectral::amplitudes::traversal_q;
+use crate::spectral::budget::{DROP, NODE_ERROR, ORDER_TAIL};
+use crate::spectral::fringe;
+use crate::spectral::layout::{self, Group, Layout, MAX_ORDER};
+use crate::spectral::nodes::{self, LEVELS, MAX_NODES};
+use crate::spectral::shared;
+use crate::spectral::survey::Survey;
+use crate::spectral::weights::WeightSet;
+use nalgebra::{Matrix2, Matrix4};
+use num_complex::Complex64 as C64;
+use std::f64::consts::TAU;
+
+/// How the path-class method integrates a plate.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Plan {
+    /// Highest coherent order (the rest is the incoherent tail).
+    pub order: usize,
+    /// Pairs of different orders can be visible (a round trip within the coherence of the
+    /// weights).
+    pub cross_orders: bool,
+    /// The tail's share of the light, `ρ^{2(N+1)}/(1 − ρ²)`, for its node level.
+    pub tail_strength: f64,
+}
+
+/// The level of the nodes through which a chirped group's phase is interpolated.
+const PHASE_LEVEL: usize = 4;
+
+/// The plan for `survey` over `set`: the coherent order `N` is the first whose next order's
+/// pairs fall below [`ORDER_TAIL`] (across orders: `ρⁿ` times the visibility of `n` round
+/// trips; within an order, where mode conversions keep paths of equal counts coherent:
+/// `ρ^{2n}`), at most [`MAX_ORDER`] (beyond, the tail takes the rest: plates near grazing
+/// incidence, where the round trip reflects nearly everything; `tests/spectral_grazing.rs`
+/// measures that error). `None` if the orders do not converge (`ρ ≥ 1`).
+pub fn plan(s: &Survey, set: WeightSet) -> Option<Plan> {
+    let rho = s.rho;
+    // `ρ ≥ 1` or NaN: the orders do not converge.
+    if rho.is_nan() || rho >= 1.0 {
+        return None;
+    }
+    let rule = fringe::rule(set, 0);
+    let round_trip = s.group_path_range(|g| g[0].min(g[1]) + g[2].min(g[3])).0;
+    let split = s
+        .group_path_range(|g| (g[1] - g[0]).abs().max((g[3] - g[2]).abs()))
+        .1;
+    let sum = 1.0 / (1.0 - rho);
+    let order = (0..=MAX_ORDER)
+        .find(|&n| {
+            let next = (n + 1) as f64;
+            let across =
+                rho.powf(next) * rule.visibility_beyond(next * round_trip - 2.0 * next * split);
+            let within = rho.powf(2.0 * next);
+            sum * across.max(within) < ORDER_TAIL
+        })
+        .unwrap_or(MAX_ORDER);
+    // The nearest fringe of a pair one round trip apart: a round trip less the split of one
+    // traversal each way (pairs that differ in the modes of more traversals as well are weaker
+    // by the mode conversions that separate them).
+    let nearest = round_trip - 2.0 * split;
+    let cross_orders = 2.0 * rho * sum * rule.visibility_beyond(nearest.max(0.0)) >= DROP;
+    Some(Plan {
+        order,
+        cross_orders,
+        tail_strength: rho.powi(2 * (order as i32 + 1)) / (1.0 - rho * rho),
+    })
+}
+
+/// A kept group: where it lies in its layout and how it is integrated.
+#[derive(Clone, Copy)]
+struct Placed {
+    lobe: usize,
+    group: usize,
+    /// Level of its amplitude nodes.
+    amplitude_level: usize,
+    /// Level of its phase nodes; `None`: a chirped group ([`Integration::dense`]).
+    level: Option<usize>,
+    strength: f64,
+    group_path: f64,
+    /// The highest order of its classes.
+    order: usize,
+    /// Its node shares `ω_ic`: a range of [`Work::omega`], one per amplitude node.
+    omega: usize,
+}
+
+/// The working memory of one integration (per thread, reused).
+struct Work {
+    classes: ClassAmplitudes,
+    placed: Vec<Placed>,
+    omega: Vec<[C64; 3]>,
+    norms: Vec<f64>,
+    /// `Q` per traversal at each finest-level node that a phase uses.
+    q: [Option<[C64; 4]>; MAX_NODES],
+}
+
+thread_local! {
+    static WORK: Pool<Work> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
+fn work() -> Pooled<Work> {
+    let mut w = Pooled::take(&WORK, || {
+        Box::new(Work {
+            classes: ClassAmplitudes::with_capacity(MAX_ORDER),
+            placed: Vec::new(),
+            omega: Vec::new(),
+            norms: Vec::new(),
+            q: [None; MAX_NODES],
+        })
+    });
+    w.placed.clear();
+    w.omega.clear();
+    w.q = [None; MAX_NODES];
+    w
+}
+
+/// `∫ w_c M` for the channels of `set` by `plan` (module docs).
+pub fn integrate(
+    s: &Survey,
+    plan: &Plan,
+    set: WeightSet,
+    want: Want,
+    output: Output,
+) -> Result<[SlabMueller; 3]> {
+    let mut w = work();
+    let w = &mut *w;
+    let lobes = [want.reflection, want.transmission];
+    let absorbing = traversal_q(&s.amplitudes.centre().q)
+        .iter()
+        .any(|q| q.im != 0.0);
+    let loss = s.loss.unwrap_or([0.0; 4]);
+    let layouts =
+        [Lobe::Reflection, Lobe::Transmission].map(|l| layout::layout(l, plan.order, absorbing));
+    // The classes at the centre decide which groups are kept.
+    w.classes.expand(s.amplitudes.centre(), plan.order, want);
+    for (l, layout) in layouts.iter().enumerate() {
+        if lobes[l] {
+            select(
+                s,
+                plan,
+                set,
+                l,
+                layout,
+                &w.classes,
+                &loss,
+                &mut w.norms,
+                &mut w.placed,
+            );
+        }
+    }
+    phases(s, w)?;
+    let it = Integration { s, set };
+    for p in 0..w.placed.len() {
+        let start = w.omega.len();
+        w.placed[p].omega = start;
+        let n = LEVELS[w.placed[p].amplitude_level];
+        w.omega.resize(start + n, [C64::new(0.0, 0.0); 3]);
+        let placed = w.placed[p];
+        let group = &layouts[placed.lobe].groups[placed.group];
+        it.shares(&placed, group, &w.q, &mut w.omega[start..start + n]);
+    }
+    let tail_level = s.amplitudes.level_for(plan.tail_strength);
+    let mut acc = [[Matrix4::<C64>::zeros(); 2]; 3];
+    let mut tails = [[Matrix4::<f64>::zeros(); 2]; 3];
+    let own = nodes::level(s.amplitudes.level);
+    let tail_rule = fringe::rule(set, tail_level);
+    let (k0, a) = fringe::band();
+    // The centre first: its classes are still expanded from the selection.
+    let centre = own.nodes.len() / 2;
+    let visit = std::iter::once(centre).chain((0..own.nodes.len()).filter(|&i| i != centre));
+    for i in visit {
+        let (j, t) = (own.in_finest[i], own.nodes[i]);
+        // Node j's index in each level (None where it is not one of the level's nodes).
+        let index: [Option<usize>; LEVELS.len()] =
+            std::array::from_fn(|l| nodes::level(l).in_finest.iter().position(|&f| f == j));
+        let uses = |level: usize| index[level].is_some();
+        let with_tail = uses(tail_level);
+        let order = w
+            .placed
+            .iter()
+            .filter(|p| uses(p.amplitude_level))
+            .map(|p| p.order)
+            .max();
+        let order = if with_tail { Some(plan.order) } else { order };
+        let Some(order) = order else { continue };
+        let blocks = s.amplitudes.exact(j).expect("an amplitude node");
+        if i != centre || order != plan.order {
+            w.classes.expand(blocks, order, want);
+        }
+        for p in w.placed.iter() {
+            let Some(node) = index[p.amplitude_level] else {
+                continue;
+            };
+            let layout = layouts[p.lobe];
+            let m = pair_sum(layout, &layout.groups[p.group], &w.classes, p.lobe, output);
+            let shares = &w.omega[p.omega + node];
+            for (acc_c, share) in acc.iter_mut().zip(shares) {
+                add_scaled(&mut acc_c[p.lobe], &m, *share, output);
+            }
+        }
+        if let Some(node) = index[tail_level] {
+            let lambda = TAU / (k0 + a * t);
+            let tail = w.classes.tail(blocks, s.amplitudes.merged, lambda, want);
+            let wt = tail_rule.weight(0.0, node);
+            for (c, t_c) in tails.iter_mut().enumerate() {
+                t_c[0] += tail.r * wt[c].re;
+                t_c[1] += tail.t * wt[c].re;
+            }
+        }
+    }
+    Ok(std::array::from_fn(|c| {
+        let lobe = |l: usize| {
+            lobes[l].then(|| {
+                let m = match output {
+                    Output::Mueller => mueller::from_coherency(&acc[c][l]),
+                    Output::Intensity => {
+                        let mut m = Matrix4::zeros();
+                        m[(0, 0)] = 0.5
+                            * INTENSITY_ENTRIES
+                                .iter()
+                                .map(|e| acc[c][l][*e])
+                                .sum::<C64>()
+                                .re;
+                        m
+                    }
+                } + tails[c][l];
+                output
+                    .keep(SlabMueller {
+                        r: Some(m),
+                        t: None,
+                    })
+                    .r
+                    .expect("kept")
+            })
+        };
+        SlabMueller {
+            r: lobe(0),
+            t: lobe(1),
+        }
+    }))
+}
+
+/// The groups of lobe `l` worth integrating, with their levels: each class's strength is its
+/// norm at the centre times its least attenuation over the band; a group's, the sum over its
+/// pairs (2 for a pair of two classes); a group whose strength times its fringe's visibility
+/// is below [`DROP`] is dropped, and so is every block whose classes cannot reach it.
+#[allow(clippy::too_many_arguments)]
+fn select(
+    s: &Survey,
+    plan: &Plan,
+    set: WeightSet,
+    l: usize,
+    layout: &Layout,
+    classes: &ClassAmplitudes,
+    loss: &[f64; 4],
+    norms: &mut Vec<f64>,
+    placed: &mut Vec<Placed>,
+) {
+    let amps: &[Matrix2<C64>] = if l == 0 {
+        &classes.reflection
+    } else {
+        &classes.transmission
+    };
+    norms.clear();
+    let mut strongest = [0.0f64; MAX_ORDER + 1];
+    for (k, c) in layout.counts.iter().enumerate() {
+        let attenuation: f64 = (0..4).map(|m| f64::from(c[m]) * loss[m]).sum();
+        let n = amps[k].norm() * (-attenuation).exp();
+        norms.push(n);
+        let o = layout.orders[k] as usize;
+        strongest[o] = strongest[o].max(n);
+    }
+    let rule = fringe::rule(set, 0);
+    let g = s.group_path.map(|x| x.re);
+    // A group (or a block of them) goes when its strength times its visibility is below DROP.
+    let drop = |bound: f64| bound < DROP;
+    for block in &layout.blocks {
+        let (m, n) = block.orders;
+        if m != n && !plan.cross_orders {
+            continue;
+        }
+        let strongest_pair = 2.0 * strongest[m] * strongest[n];
+        if drop(strongest_pair * (block.pairs.end - block.pairs.start) as f64) {
+            continue;
+        }
+        for (gi, group) in layout.groups[block.groups.clone()].iter().enumerate() {
+            let path = |g: &[f64; 4]| {
+                (0..4)
+                    .map(|k| f64::from(group.delta[k]) * g[k])
+                    .sum::<f64>()
+            };
+            let group_path = path(&g);
+            let visibility = visibility(rule, s.group_path_range(path));
+            let most = strongest_pair * (group.pairs.end - group.pairs.start) as f64;
+            if visibility == 0.0 || drop(most * visibility) {
+                continue;
+            }
+            let strength: f64 = layout.pairs[group.pairs.clone()]
+                .iter()
+                .map(|&(a, b)| {
+                    let w = if a == b { 1.0 } else { 2.0 };
+                    w * norms[a as usize] * norms[b as usize]
+                })
+                .sum();
+            if drop(strength * visibility) {
+                continue;
+            }
+            let amplitude_level = s.amplitudes.level_for(strength);
+            let level = phase_level(s, group, strength, group_path, amplitude_level);
+            placed.push(Placed {
+                lobe: l,
+                group: block.groups.start + gi,
+                amplitude_level,
+                level,
+                strength,
+                group_path,
+                order: n,
+                omega: 0,
+            });
+        }
+    }
+}
+
+/// The visibility of a fringe whose group path moves over `(lo, hi)` across the band (dispersion:
+/// a chirped fringe is seen where its local group path is): that of its one group path when it
+/// barely moves, else the largest beyond its nearest, and 1 where it passes through zero.
+fn visibility(rule: &fringe::FringeRule, (lo, hi): (f64, f64)) -> f64 {
+    if hi - lo < fringe::STEP_NM {
+        rule.visibility(0.5 * (lo + hi))
+    } else if lo <= 0.0 && hi >= 0.0 {
+        1.0
+    } else {
+        rule.visibility_beyond(lo.abs().min(hi.abs()))
+    }
+}
+
+/// The phase level a group needs: at least its amplitudes', and enough to interpolate its
+/// absorption tilt (`x`: the change of its attenuation exponent across the half band) and its
+/// residual phase (`c`: its largest value at the amplitude nodes) to [`NODE_ERROR`] over its
+/// strength; `None` if even the finest level does not.
+fn phase_level(
+    s: &Survey,
+    g: &Group,
+    strength: f64,
+    group_path: f64,
+    amplitude_level: usize,
+) -> Option<usize> {
+    let (_, a) = fringe::band();
+    let x = a
+        * (0..4)
+            .map(|m| f64::from(g.sum[m]) * s.group_path[m].im)
+            .sum::<f64>()
+            .abs();
+    let c = residual(s, g, group_path);
+    let tolerance = NODE_ERROR / strength.max(1e-300);
+    (amplitude_level..LEVELS.len()).find(|&l| slow_factor_error(LEVELS[l], x, c) <= tolerance)
+}
+
+/// The largest residual phase `|φ_Δ(k) − φ_Δ(k₀) − G_Δ (k − k₀)|` of a group over the
+/// amplitude nodes (zero without dispersion).
+fn residual(s: &Survey, g: &Group, group_path: f64) -> f64 {
+    if !s.plate.is_dispersive() {
+        return 0.0;
+    }
+    let (k0, a) = fringe::band();
+    let d = s.plate.thickness_nm;
+    let phase = |j: usize, k: f64| {
+        let q = traversal_q(&s.amplitudes.exact(j).expect("an amplitude node").q);
+        k * d * (0..4).map(|m| f64::from(g.delta[m]) * q[m].re).sum::<f64>()
+    };
+    let centre = phase(MAX_NODES / 2, k0);
+    let lv = nodes::level(s.amplitudes.level);
+    lv.in_finest
+        .iter()
+        .zip(&lv.nodes)
+        .map(|(&j, t)| (phase(j, k0 + a * t) - centre - group_path * a * t).abs())
+        .fold(0.0, f64::max)
+}
+
+/// The layer's `Q` per traversal at every finest-level node a group's phase uses (exact: at the
+/// amplitude nodes from the blocks, elsewhere from the indices; a group's phase needs
+/// `k d Δ·Q` to a small fraction of a radian, which interpolated indices do not give in thick
+/// plates).
+fn phases(s: &Survey, w: &mut Work) -> Result<()> {
+    let (k0, a) = fringe::band();
+    let finest = w
+        .placed
+        .iter()
+        .map(|p| p.level.unwrap_or(PHASE_LEVEL))
+        .max()
+        .unwrap_or(0);
+    let lv = nodes::level(finest);
+    let centre = traversal_q(&s.amplitudes.centre().q);
+    for (&j, t) in lv.in_finest.iter().zip(&lv.nodes) {
+        w.q[j] = Some(match s.amplitudes.exact(j) {
+            Some(b) => traversal_q(&b.q),
+            None if s.plate.is_dispersive() => {
+                traversal_q(&s.plate.layer_q(TAU / (k0 + a * t), &s.frame, s.beta)?)
+            }
+            None => centre,
+        });
+    }
+    Ok(())
+}
+
+/// What one integration shares between its groups.
+struct Integration<'a, 'b> {
+    s: &'a Survey<'b>,
+    set: WeightSet,
+}
+
+impl Integration<'_, '_> {
+    /// A group's share per amplitude node and channel, `ω_ic = e^{iφ_Δ(k₀)} Σ_p factor_p W_pc(G)
+    /// L_i(k_p)` (module docs), into `out`.
+    fn shares(
+        &self,
+        p: &Placed,
+        g: &Group,
+        q: &[Option<[C64; 4]>; MAX_NODES],
+        out: &mut [[C64; 3]],
+    ) {
+        let Some(level) = p.level else {
+            return self.dense(p, g, q, out);
+        };
+        let (k0, a) = fringe::band();
+        let d = self.s.plate.thickness_nm;
+        let dot = |x: &[C64; 4], im: bool| -> f64 {
+            (0..4)
+                .map(|m| {
+                    f64::from(if im { g.sum[m] } else { g.delta[m] })
+                        * if im { x[m].im } else { x[m].re }
+                })
+                .sum()
+        };
+        let centre = q[MAX_NODES / 2].expect("the centre's phase");
+        let carrier = C64::from_polar(1.0, k0 * d * dot(&centre, false));
+        let rule = fringe::rule(self.set, level);
+        let amp = nodes::level(p.amplitude_level);
+        let finest = &nodes::level(nodes::FINEST).nodes;
+        for (i, &j) in nodes::level(level).in_finest.iter().enumerate() {
+            let k = k0 + a * finest[j];
+            let qj = q[j].expect("a phase at every node of a used level");
+            let residual =
+                k * d * dot(&qj, false) - k0 * d * dot(&centre, false) - p.group_path * (k - k0);
+            let attenuation = (-k * d * dot(&qj, true)).exp();
+            let factor = C64::from_polar(attenuation, residual) * carrier;
+            let wpc = rule.weight(p.group_path, i);
+            for (n, l) in amp.to_finest[j].iter().enumerate() {
+                if *l != 0.0 {
+                    for c in 0..3 {
+                        out[n][c] += factor * wpc[c] * *l;
+                    }
+                }
+            }
+        }
+    }
+
+    /// A group whose residual phase no level resolves (the chirp of a thick, strongly
+    /// dispersive plate), on a shared product-integration rule of the weights
+    /// ([`crate::spectral::shared`]): `ω_ic = Σ_j W_jc e^{iφ(k_j) − α(k_j)} L_i(k_j)` with its
+    /// phase `φ(k) = k d Δ·Re Q(k)` and attenuation `α(k) = k d Σ·Im Q(k)` from their Chebyshev
+    /// interpolants through the exact values at the nodes of [`PHASE_LEVEL`] (`Q` is analytic
+    /// around the band: they converge geometrically) and its amplitude interpolated between its
+    /// amplitude nodes. The rule is the smallest whose error on an oscillation as fast as the
+    /// group's fastest local fringe (`max |φ'|`) meets [`NODE_ERROR`] over its strength, at most
+    /// the largest rung (1024 points).
+    fn dense(
+        &self,
+        p: &Placed,
+        g: &Group,
+        q: &[Option<[C64; 4]>; MAX_NODES],
+        out: &mut [[C64; 3]],
+    ) {
+        let (k0, a) = fringe::band();
+        let d = self.s.plate.thickness_nm;
+        let lv = nodes::level(PHASE_LEVEL);
+        let sample = |im: bool| -> Vec<f64> {
+            lv.in_finest
+                .iter()
+                .map(|&j| {
+                    let x = q[j].expect("the phase level's phases are computed");
+                    (0..4)
+                        .map(|m| {
+                            if im {
+                                f64::from(g.sum[m]) * x[m].im
+                            } else {
+                                f64::from(g.delta[m]) * x[m].re
+                            }
+                        })
+                        .sum()
+                })
+                .collect()
+        };
+        let (phase, loss) = (
+            nodes::chebyshev(&sample(false)),
+            nodes::chebyshev(&sample(true)),
+        );
+        // The fastest local fringe, d(k d f(t))/dk = d (f + k f'(t)/a), over the band.
+        let fastest = (0..=16)
+            .map(|s| {
+                let t = -1.0 + s as f64 / 8.0;
+                let (f, f1, _) = nodes::chebyshev_eval(&phase, t);
+                (d * (f + (k0 + a * t) * f1 / a)).abs()
+            })
+            .fold(0.0, f64::max);
+        let tolerance = NODE_ERROR / p.strength.max(1e-300);
+        let points = shared::LADDER
+            .iter()
+            .copied()
+            .find(|&n| {
+                shared::rule(self.set, n).error_at(shared::SPAN_MARGIN * fastest) <= tolerance
+            })
+            .unwrap_or(shared::LADDER[shared::LADDER.len() - 1]);
+        let rule = shared::rule(self.set, points);
+        let bases = shared::node_basis(self.set, points, p.amplitude_level);
+        let n = LEVELS[p.amplitude_level];
+        for (&(k, w), basis) in rule.nodes.iter().zip(bases) {
+            let t = C64::new((k - k0) / a, 0.0);
+            let phi = k * d * nodes::chebyshev_at(&phase, t).re;
+            let alpha = k * d * nodes::chebyshev_at(&loss, t).re;
+            let factor = C64::from_polar((-alpha).exp(), phi);
+            let fw = [factor * w[0], factor * w[1], factor * w[2]];
+            for (o, l) in out.iter_mut().zip(&basis[..n]) {
+                for c in 0..3 {
+                    o[c] += fw[c] * *l;
+                }
+            }
+        }
+    }
+}
+
+/// `Σ_pairs w cross(A_a, A_b)` of a group at one node (`w` = 1 for a class with itself, 2
+/// otherwise), all 16 entries or only those of `M00`.
+fn pair_sum(
+    layout: &Layout,
+    g: &Group,
+    classes: &ClassAmplitudes,
+    lobe: usize,
+    output: Output,
+) -> Matrix4<C64> {
+    let amps: &[Matrix2<C64>] = if lobe == 0 {
+        &classes.reflection
+    } else {
+        &classes.transmission
+    };
+    let mut m = Matrix4::zeros();
+    for &(a, b) in &layout.pairs[g.pairs.clone()] {
+        let w = if a == b { 1.0 } else { 2.0 };
+        cross_add(
+            &mut m,
+            &amps[a as usize],
+            &amps[b as usize],
+            w,
+            output == Output::Intensity,
+        );
+    }
+    m
+}
+
+/// The error of interpolating a group's slow factor on `n` Chebyshev–Lobatto nodes: its
+/// absorption tilt `e^{−x t}` (Chebyshev coefficients `2 I_j(x) ≈ 2 (x/2)^j / j!`: the first one
+/// not resolved is `j = n`) and its residual phase `e^{ict²} = e^{ic/2} e^{i(c/2) T₂(t)}`
+/// (coefficients `2 J_m(c/2) ≈ 2 (c/4)^m / m!` of `T_{2m}`: the first not resolved is
+/// `m = ⌊(n−1)/2⌋ + 1`), `t ∈ [−1, 1]` across the band.
+fn slow_factor_error(n: usize, x: f64, c: f64) -> f64 {
+    let term = |z: f64, j: usize| (1..=j).fold(2.0, |e, i| e * z / i as f64);
+    term(0.5 * x, n) + term(0.25 * c, (n - 1) / 2 + 1)
+}
+
+/// The entries of a coherency that `M00` needs: `M00 = ½ Re(K₀₀ + K₀₃ + K₃₀ + K₃₃)`.
+const INTENSITY_ENTRIES: [(usize, usize); 4] = [(0, 0), (0, 3), (3, 0), (3, 3)];
+
+/// `acc += s conj(x) ⊗ y` (all 16 entries, or with `intensity` only [`INTENSITY_ENTRIES`]).
+#[inline]
+fn cross_add(acc: &mut Matrix4<C64>, x: &Matrix2<C64>, y: &Matrix2<C64>, s: f64, intensity: bool) {
+    let xc = [
+        x[(0, 0)].conj() * s,
+        x[(0, 1)].conj() * s,
+        x[(1, 0)].conj() * s,
+        x[(1, 1)].conj() * s,
+    ];
+    if intensity {
+        acc[(0, 0)] += xc[0] * y[(0, 0)];
+        acc[(0, 3)] += xc[1] * y[(0, 1)];
+        acc[(3, 0)] += xc[2] * y[(1, 0)];
+        acc[(3, 3)] += xc[3] * y[(1, 1)];
+        return;
+    }
+    // Kronecker product: entry (2 r1 + r2, 2 c1 + c2) = conj(x[r1][c1]) y[r2][c2].
+    for r1 in 0..2 {
+        for c1 in 0..2 {
+            let xv = xc[2 * r1 + c1];
+            for r2 in 0..2 {
+                for c2 in 0..2 {
+                    acc[(2 * r1 + r2, 2 * c1 + c2)] += xv * y[(r2, c2)];
+                }
+            }
+        }
+    }
+}
+
+/// `acc += m w` over the entries the output needs.
+#[inline]
+fn add_scaled(acc: &mut Matrix4<C64>, m: &Matrix4<C64>, w: C64, output: Output) {
+    if output == Output::Intensity {
+        for e in INTENSITY_ENTRIES {
+            acc[e] += m[e] * w;
+        }
+    } else {
+        for (a, x) in acc.as_mut_slice().iter_mut().zip(m.as_slice()) {
+            *a += x * w;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cross_add_is_the_kronecker_product() {
+        let x = Matrix2::new(
+            C64::new(0.3, -0.2),
+            C64::new(-0.1, 0.5),
+            C64::new(0.7, 0.05),
+            C64::new(-0.4, -0.6),
+        );
+        let y = Matrix2::new(
+            C64::new(-0.25, 0.1),
+            C64::new(0.6, -0.3),
+            C64::new(0.02, 0.9),
+            C64::new(0.5, 0.45),
+        );
+        let mut acc = Matrix4::zeros();
+        cross_add(&mut acc, &x, &y, 2.0, false);
+        assert!((acc - mueller::cross(&x, &y) * C64::new(2.0, 0.0)).norm() < 1e-15);
+        let mut m00 = Matrix4::zeros();
+        cross_add(&mut m00, &x, &y, 2.0, true);
+        for e in INTENSITY_ENTRIES {
+            assert!((m00[e] - acc[e]).norm() < 1e-15);
+        }
+    }
+}

@@ -1,0 +1,108 @@
+//! What a plate at one incidence looks like across the visible band, before any method is
+//! chosen: its interface blocks at the amplitude nodes ([`Amplitudes`]) and the invariants read
+//! off them (the traversals' group paths and attenuation rates, the least attenuation, the
+//! round trip's reflectance). [`crate::spectral::route`] decides from these alone; every
+//! method then starts from the same solved blocks.
+
+use crate::cmath::spectral_norm;
+use crate::error::Result;
+use crate::optics::frame::PlaneFrame;
+use crate::plate::Plate;
+use crate::spectral::amplitudes::{least_attenuation, Amplitudes};
+use crate::spectral::budget::ATTENUATED;
+use crate::spectral::fringe;
+use crate::spectral::nodes::{self, SPAN};
+use num_complex::Complex64 as C64;
+use std::f64::consts::TAU;
+
+/// A plate at one incidence, surveyed across the band.
+pub struct Survey<'a> {
+    /// The plate.
+    pub plate: &'a Plate,
+    /// Its plane of incidence.
+    pub frame: PlaneFrame,
+    /// The incidence parameter.
+    pub beta: C64,
+    /// The interface blocks at the amplitude nodes.
+    pub amplitudes: Amplitudes,
+    /// Per traversal `[o↓, e↓, o↑, e↑]` at the band's centre: `d · d(k Q)/dk` (nm), the real
+    /// part the group path of one traversal, the imaginary part the rate of its attenuation
+    /// exponent.
+    pub group_path: [C64; 4],
+    /// The traversals' group paths (real parts) at [`SPAN`] of the band (dispersion moves them
+    /// across it).
+    pub group_paths: [[f64; 4]; SPAN.len()],
+    /// The least attenuation exponent per traversal over the band; `None` where a clear
+    /// layer's wave turns evanescent inside the band
+    /// ([`crate::spectral::amplitudes::least_attenuation`]).
+    pub loss: Option<[f64; 4]>,
+    /// An upper bound, over the band, of the spectral norm of one internal round trip
+    /// `r₃ P↑ r₂ P↓`: `‖r₃‖ ‖r₂‖` times the largest attenuation factors (the norm of the `n`-th
+    /// round trip is at most `ρⁿ`).
+    pub rho: f64,
+}
+
+impl<'a> Survey<'a> {
+    /// Solves `plate` at the amplitude nodes for incidence `beta` in the plane of `frame`.
+    pub fn new(plate: &'a Plate, frame: PlaneFrame, beta: C64) -> Result<Self> {
+        let amplitudes = Amplitudes::new(plate, &frame, beta)?;
+        let d = plate.thickness_nm;
+        let at = amplitudes.group_indices();
+        let group_path = at[SPAN.len() / 2].map(|g| g * d);
+        let group_paths = at.map(|g| g.map(|x| x.re * d));
+        let loss = least_attenuation(plate, &amplitudes);
+        let rho = round_trip_bound(&amplitudes);
+        Ok(Survey {
+            plate,
+            frame,
+            beta,
+            amplitudes,
+            group_path,
+            group_paths,
+            loss,
+            rho,
+        })
+    }
+
+    /// True for a traversal that carries light somewhere in the band (its least attenuation
+    /// below [`ATTENUATED`]).
+    pub fn live(&self, traversal: usize) -> bool {
+        self.loss.is_none_or(|l| l[traversal] < ATTENUATED)
+    }
+
+    /// The smallest and largest of `f(group paths)` over [`SPAN`].
+    pub fn group_path_range(&self, f: impl Fn(&[f64; 4]) -> f64) -> (f64, f64) {
+        self.group_paths
+            .iter()
+            .map(f)
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+                (lo.min(x), hi.max(x))
+            })
+    }
+
+    /// The largest change of a live traversal's attenuation exponent across the half band
+    /// (`a · d · |d(k Im Q)/dk|`).
+    pub fn attenuation_tilt(&self) -> f64 {
+        let (_, a) = fringe::band();
+        (0..4)
+            .filter(|&j| self.live(j))
+            .map(|j| a * self.group_path[j].im.abs())
+            .fold(0.0, f64::max)
+    }
+}
+
+/// `max over the amplitude nodes of ‖r₃‖ ‖r₂‖ max|P↑| max|P↓|` (spectral norms).
+fn round_trip_bound(amplitudes: &Amplitudes) -> f64 {
+    let (k0, a) = fringe::band();
+    let lv = nodes::level(amplitudes.level);
+    lv.in_finest
+        .iter()
+        .zip(&lv.nodes)
+        .map(|(&j, t)| {
+            let b = amplitudes.exact(j).expect("an amplitude node");
+            let (pd, pu) = b.propagation(TAU / (k0 + a * t));
+            let most = |p: [C64; 2]| p[0].norm().max(p[1].norm());
+            spectral_norm(&b.r3) * spectral_norm(&b.r2) * most(pd) * most(pu)
+        })
+        .fold(0.0, f64::max)
+}

@@ -1,0 +1,205 @@
+//! The methods of the closed-form integration over colour channels, each on the plates its
+//! route sends it (`spectral::route`), against a dense quadrature of the exact plate with the
+//! fitted Gaussian weights themselves as the spectrum: that isolates each method's own error
+//! from the fit's (which `tests/spectral_rgb.rs` measures in CIEDE2000). Each approximation of
+//! a method is held to 1e-5 of the white response (`spectral::budget`); several add up, so every
+//! Mueller entry of every channel must agree within 1e-4. Also: a plate of zero thickness is
+//! the bare interface it reduces to, to rounding.
+
+mod common;
+
+use birefringent::material::Material;
+use birefringent::optics::frame::PlaneFrame;
+use birefringent::optics::fresnel::Fresnel;
+use birefringent::plate::slab::{Output, SlabMueller, Want};
+use birefringent::plate::Plate;
+use birefringent::spectral::model::{Accuracy, PlateModel};
+use birefringent::spectral::route::{self, Route};
+use birefringent::spectral::survey::Survey;
+use birefringent::spectral::weights::{fit_per_wavenumber, gaussians, WeightSet};
+use birefringent::C64;
+use nalgebra::{Matrix4, Vector3};
+use std::f64::consts::TAU;
+
+const SET: WeightSet = WeightSet::XyzD65;
+
+fn plate(material: Material, thickness_nm: f64, exit: f64) -> Plate {
+    Plate {
+        material,
+        birefringence: 0.0,
+        ext: C64::new(1.0, 0.0),
+        exit: C64::new(exit, 0.0),
+        axis: Vector3::new(0.6, -0.3, 0.742).normalize(),
+        thickness_nm,
+    }
+}
+
+fn incidence(theta_deg: f64) -> (PlaneFrame, C64) {
+    (
+        PlaneFrame::from_azimuth(0.7),
+        C64::new(theta_deg.to_radians().sin(), 0.0),
+    )
+}
+
+/// `∫ fit_c(k) M(k) dk` by composite Simpson in `k` over every Gaussian's `μ ± 7σ`, the exact
+/// plate at every node, `steps` intervals.
+fn dense(p: &Plate, theta_deg: f64, steps: usize) -> [SlabMueller; 3] {
+    let (frame, beta) = incidence(theta_deg);
+    let all = (0..3).flat_map(|c| gaussians(SET, c).iter());
+    let lo = all
+        .clone()
+        .map(|g| g.mu - 7.0 * g.sigma)
+        .fold(f64::INFINITY, f64::min);
+    let hi = all.map(|g| g.mu + 7.0 * g.sigma).fold(0.0, f64::max);
+    let h = (hi - lo) / steps as f64;
+    let mut acc = [[Matrix4::<f64>::zeros(); 2]; 3];
+    for i in 0..=steps {
+        let k = lo + h * i as f64;
+        let simpson = if i == 0 || i == steps {
+            1.0
+        } else if i % 2 == 1 {
+            4.0
+        } else {
+            2.0
+        } * h
+            / 3.0;
+        let m = p
+            .at(TAU / k)
+            .unwrap()
+            .optics(&frame, beta)
+            .unwrap()
+            .mueller(TAU / k, Want::BOTH)
+            .unwrap();
+        for (c, a) in acc.iter_mut().enumerate() {
+            let w = fit_per_wavenumber(SET, c, k) * simpson;
+            a[0] += m.r.unwrap() * w;
+            a[1] += m.t.unwrap() * w;
+        }
+    }
+    acc.map(|[r, t]| SlabMueller {
+        r: Some(r),
+        t: Some(t),
+    })
+}
+
+fn analytic(p: &Plate, theta_deg: f64) -> [SlabMueller; 3] {
+    let (frame, beta) = incidence(theta_deg);
+    PlateModel::new(p, frame, beta)
+        .channels(SET, Want::BOTH, Output::Mueller, Accuracy::Perceptual)
+        .unwrap()
+}
+
+fn route_of(p: &Plate, theta_deg: f64) -> Route {
+    let (frame, beta) = incidence(theta_deg);
+    route::choose(&Survey::new(p, frame, beta).unwrap(), SET).unwrap()
+}
+
+/// The largest difference of any Mueller entry of either lobe over the channels.
+fn worst(a: &[SlabMueller; 3], b: &[SlabMueller; 3]) -> f64 {
+    a.iter()
+        .zip(b)
+        .flat_map(|(x, y)| {
+            [(x.r, y.r), (x.t, y.t)].map(|(u, v)| (u.unwrap() - v.unwrap()).abs().max())
+        })
+        .fold(0.0, f64::max)
+}
+
+/// Each route on plates it serves, against the dense quadrature (module docs): the route
+/// taken is the one named (a change of the decision shows here), and the entries agree within
+/// 1e-4.
+#[test]
+fn each_route_matches_dense_quadrature_with_the_fitted_weights() {
+    let quartz = || Material::named("quartz", 0.0, 0.0).unwrap();
+    let calcite = || Material::named("calcite", 0.0, 0.0).unwrap();
+    let glassy = |dn: f64, kappa: f64| {
+        Material::constant(C64::new(1.52, kappa), C64::new(1.52 + dn, 0.3 * kappa)).unwrap()
+    };
+    // (plate, incidence, expected route, Simpson intervals).
+    let cases: Vec<(Plate, f64, &str, usize)> = vec![
+        (plate(quartz(), 0.0, 1.5), 35.0, "whole", 400),
+        (plate(calcite(), 30.0, 1.0), 60.0, "whole", 400),
+        (plate(quartz(), 50.0, 1.0), 20.0, "whole", 2_000),
+        (plate(quartz(), 800.0, 1.0), 20.0, "families", 4_000),
+        (plate(quartz(), 2_900.0, 1.0), 85.6, "families", 40_000),
+        (
+            plate(glassy(2e-3, 0.0), 2_400.0, 1.0),
+            89.0,
+            "families",
+            200_000,
+        ),
+        (plate(glassy(2e-4, 0.0), 3e6, 1.0), 30.0, "classes", 400_000),
+        (plate(quartz(), 35_000.0, 1.5), 33.0, "classes", 40_000),
+        (plate(calcite(), 100_000.0, 1.0), 47.0, "classes", 100_000),
+        (
+            plate(glassy(-3e-2, 2e-5), 600_000.0, 1.0),
+            61.0,
+            "classes",
+            400_000,
+        ),
+        (plate(calcite(), 5_000.0, 1.0), 10.0, "classes", 20_000),
+        (
+            plate(Material::named("rutile", 0.0, 0.0).unwrap(), 1_300.0, 1.0),
+            63.0,
+            "dense",
+            40_000,
+        ),
+    ];
+    for (p, theta, expected, steps) in cases {
+        let r = route_of(&p, theta);
+        let name = match r {
+            Route::Envelope(e) if e.families.is_none() => "whole",
+            Route::Envelope(_) => "families",
+            Route::Classes(_) => "classes",
+            Route::Dense(_) => "dense",
+            Route::Evanescent(_) => "evanescent",
+        };
+        let d = p.thickness_nm * 1e-3;
+        assert_eq!(name, expected, "route of {d} um at {theta} deg: {r:?}");
+        let e = worst(&analytic(&p, theta), &dense(&p, theta, steps));
+        println!("{expected:>9}: {d:>8} um at {theta:>5} deg: worst |dM| {e:.2e}");
+        assert!(e < 1e-4, "{expected}: {d} um at {theta} deg: {e:e}");
+    }
+}
+
+/// A plate of zero thickness is its two faces at one place: between equal media it reflects
+/// nothing and transmits everything (to rounding, not to a fit's accuracy: the spectrum is
+/// flat; the exact faces' own error near grazing incidence reaches 1.2e-8 at 89.5 degrees,
+/// hence 1e-7),
+/// and between air and glass it is the bare interface, whose Fresnel amplitudes do not depend
+/// on the wavelength: the channels' integral is that interface's Mueller matrix times each
+/// channel's mass.
+#[test]
+fn zero_thickness_is_the_bare_interface() {
+    for name in ["quartz", "calcite", "rutile"] {
+        for theta in [0.0, 30.0, 70.0, 89.5] {
+            let air = plate(Material::named(name, 0.0, 0.0).unwrap(), 0.0, 1.0);
+            let m = analytic(&air, theta);
+            for (c, mc) in m.iter().enumerate() {
+                let mass: f64 = gaussians(SET, c).iter().map(|g| g.amplitude).sum();
+                let r = mc.r.unwrap().abs().max();
+                let t = (mc.t.unwrap() - Matrix4::identity() * mass).abs().max();
+                assert!(
+                    r < 1e-13 && t < 1e-7,
+                    "{name} at {theta}: R {r:e}, T-1 {t:e}"
+                );
+            }
+            let glass = plate(Material::named(name, 0.0, 0.0).unwrap(), 0.0, 1.5);
+            let (_, beta) = incidence(theta);
+            let f = Fresnel::new(C64::new(1.0, 0.0), C64::new(1.5, 0.0), beta).unwrap();
+            let rs = f.r_above[0].norm_sqr();
+            let rp = f.r_above[1].norm_sqr();
+            for (c, mc) in analytic(&glass, theta).iter().enumerate() {
+                let mass: f64 = gaussians(SET, c).iter().map(|g| g.amplitude).sum();
+                let r = mc.r.unwrap();
+                // The unpolarised reflectance and its linear diattenuation.
+                let (m00, m01) = (0.5 * (rs + rp) * mass, 0.5 * (rs - rp) * mass);
+                assert!(
+                    (r[(0, 0)] - m00).abs() < 1e-12 && (r[(0, 1)] - m01).abs() < 1e-12,
+                    "{name} on glass at {theta}: {} vs {m00}, {} vs {m01}",
+                    r[(0, 0)],
+                    r[(0, 1)]
+                );
+            }
+        }
+    }
+}
