@@ -9,12 +9,12 @@
 //!   incoherently (in Mueller space), the model the spectral integration evaluates;
 //! * [`plan`]: group paths, which layers are thick for a given spectrum, and how fast the
 //!   stack's spectrum oscillates;
-//! * [`interpolate`]: a dispersive stack's interface blocks interpolated across a spectrum;
-//! * [`spectral`]: the stack over colour channels and narrow bands.
+//! * [`spectral`]: the stack over colour channels and narrow bands (a dispersive stack's
+//!   interface blocks interpolated across a spectrum by the plate's Chebyshev series,
+//!   [`crate::spectral::interpolate::Interpolant`]).
 
 pub mod coherence;
 pub mod exact;
-pub mod interpolate;
 pub mod plan;
 pub mod spectral;
 

@@ -26,18 +26,27 @@ use crate::error::{Error, Result};
 use crate::optics::frame::PlaneFrame;
 use crate::plate::slab::{Output, SlabMueller, Want};
 use crate::spectral::hermite;
+use crate::spectral::interpolate::{self, Interpolant};
 use crate::spectral::model::Accuracy;
 use crate::spectral::shared::{self, LADDER, TOLERANCE};
 use crate::spectral::weights::{gaussians, WeightSet};
 use crate::stack::coherence::{self, Coherence, Prepared};
 use crate::stack::exact::{layer_q_into, StackBlocks};
-use crate::stack::interpolate::Interpolant;
 use crate::stack::plan::{layer_paths, reflectances, LayerPaths, Plan, Weight};
 use crate::stack::Stack;
 use nalgebra::Matrix4;
 use num_complex::Complex64 as C64;
 use std::cell::OnceCell;
 use std::f64::consts::TAU;
+
+/// Largest accepted error of the interpolated interface blocks at the check points
+/// ([`Interpolant`]), relative to the largest value: the blocks enter the light linearly or
+/// quadratically (amplitudes of at most 1), so an error of 1e-7 is a hundred times below the
+/// rules' tolerance of 1e-5 (the phases, which need far more digits, are computed exactly).
+pub const INTERPOLATION_TOLERANCE: f64 = 1e-7;
+/// Trailing Chebyshev coefficients of the blocks are dropped while their sum stays below this,
+/// relative to the largest value.
+const INTERPOLATION_TRUNCATION: f64 = 1e-8;
 
 /// Most panels of a narrow band's rule (8 points each).
 pub const MAX_PANELS: usize = 512;
@@ -216,8 +225,12 @@ impl<'a> StackModel<'a> {
         } else {
             let values = |k: f64| self.solve(k).map(|b| b.values());
             // Interpolating pays when there are more nodes than the interpolant solves.
-            let interpolant = if nodes.len() > 2 * crate::stack::interpolate::NODES {
-                Interpolant::new(support.0, support.1, &values)?
+            let interpolant = if nodes.len() > 2 * interpolate::NODES {
+                Interpolant::new(
+                    support,
+                    (INTERPOLATION_TOLERANCE, INTERPOLATION_TRUNCATION),
+                    &values,
+                )?
             } else {
                 None
             };
