@@ -192,21 +192,24 @@ fn timings() -> Value {
             if r <= goal { "met" } else { "not met" }
         )
     };
+    let f = |v: &Value, key: &str| v[key].as_f64().unwrap_or(f64::NAN);
     println!(
         "one wavelength: 4-layer stack {:.2} us, plate {:.2} us, ratio {}",
-        wavelength["stack_us"],
-        wavelength["plate_us"],
+        f(&wavelength, "stack_us"),
+        f(&wavelength, "plate_us"),
         verdict(&wavelength, GOAL_WAVELENGTH)
     );
     println!(
         "XYZ (both lobes, Mueller): 4-layer stack {:.1} us, plate {:.1} us, ratio {}",
-        xyz["stack_us"],
-        xyz["plate_us"],
+        f(&xyz, "stack_us"),
+        f(&xyz, "plate_us"),
         verdict(&xyz, GOAL_XYZ)
     );
     println!(
         "XYZ, zero-order quartz QWP (2 x 1 mm, dispersive) {:.0} us vs one 1 mm quartz plate {:.0} us: ratio {:.1} (no goal)",
-        quartz_xyz["stack_us"], quartz_xyz["plate_us"], quartz_xyz["ratio"]
+        f(&quartz_xyz, "stack_us"),
+        f(&quartz_xyz, "plate_us"),
+        f(&quartz_xyz, "ratio")
     );
     json!({
         "one_wavelength": wavelength, "goal_one_wavelength": GOAL_WAVELENGTH,
