@@ -68,24 +68,27 @@ pub fn plan(s: &Survey, set: WeightSet) -> Option<Plan> {
         return None;
     }
     let rule = fringe::rule(set, 0);
-    let round_trip = s.group_path_range(|g| g[0].min(g[1]) + g[2].min(g[3])).0;
-    let split = s
-        .group_path_range(|g| (g[1] - g[0]).abs().max((g[3] - g[2]).abs()))
-        .1;
+    // The nearest fringe of a pair one round trip apart: a round trip less the split of one
+    // traversal each way (pairs that differ in the modes of more traversals as well are weaker
+    // by the mode conversions that separate them), at each wavenumber of the survey's span: a
+    // chirped fringe's local frequency is its group path there, never below the least of these
+    // (taking the shortest round trip at one end of the band and the widest split at the other
+    // would call thick dispersive plates' orders coherent that are not).
+    let nearest = s
+        .group_path_range(|g| {
+            let split = (g[1] - g[0]).abs().max((g[3] - g[2]).abs());
+            g[0].min(g[1]) + g[2].min(g[3]) - 2.0 * split
+        })
+        .0;
     let sum = 1.0 / (1.0 - rho);
     let order = (0..=MAX_ORDER)
         .find(|&n| {
             let next = (n + 1) as f64;
-            let across =
-                rho.powf(next) * rule.visibility_beyond(next * round_trip - 2.0 * next * split);
+            let across = rho.powf(next) * rule.visibility_beyond(next * nearest);
             let within = rho.powf(2.0 * next);
             sum * across.max(within) < ORDER_TAIL
         })
         .unwrap_or(MAX_ORDER);
-    // The nearest fringe of a pair one round trip apart: a round trip less the split of one
-    // traversal each way (pairs that differ in the modes of more traversals as well are weaker
-    // by the mode conversions that separate them).
-    let nearest = round_trip - 2.0 * split;
     let cross_orders = 2.0 * rho * sum * rule.visibility_beyond(nearest.max(0.0)) >= DROP;
     Some(Plan {
         order,
@@ -119,6 +122,53 @@ struct Work {
     norms: Vec<f64>,
     /// `Q` per traversal at each finest-level node that a phase uses.
     q: [Option<[C64; 4]>; MAX_NODES],
+    /// The traversals' phases on the shared rules the chirped groups use (one per rung).
+    chirped: Vec<TraversalPhases>,
+}
+
+/// The four traversals' phases `k d Re Q_m(k)` and attenuations `k d Im Q_m(k)` at every point
+/// of one shared rule, from their Chebyshev interpolants through the exact values at the nodes
+/// of [`PHASE_LEVEL`]: evaluated once per query and rule, then every chirped group's phase is
+/// `Δ · phase` and its attenuation `Σ · attenuation` ([`Integration::dense`]).
+struct TraversalPhases {
+    points: usize,
+    phase: Vec<[f64; 4]>,
+    attenuation: Vec<[f64; 4]>,
+}
+
+impl TraversalPhases {
+    fn new(s: &Survey, set: WeightSet, points: usize, q: &[Option<[C64; 4]>; MAX_NODES]) -> Self {
+        let (k0, a) = fringe::band();
+        let d = s.plate.thickness_nm;
+        let lv = nodes::level(PHASE_LEVEL);
+        let series = |m: usize, im: bool| -> Vec<f64> {
+            let v: Vec<f64> = lv
+                .in_finest
+                .iter()
+                .map(|&j| {
+                    let x = q[j].expect("the phase level's phases are computed")[m];
+                    if im {
+                        x.im
+                    } else {
+                        x.re
+                    }
+                })
+                .collect();
+            nodes::chebyshev(&v)
+        };
+        let re: [Vec<f64>; 4] = std::array::from_fn(|m| series(m, false));
+        let im: [Vec<f64>; 4] = std::array::from_fn(|m| series(m, true));
+        let rule = shared::rule(set, points);
+        let at = |c: &[Vec<f64>; 4], k: f64| -> [f64; 4] {
+            let t = (k - k0) / a;
+            std::array::from_fn(|m| k * d * nodes::chebyshev_at(&c[m], t))
+        };
+        TraversalPhases {
+            points: rule.nodes.len(),
+            phase: rule.nodes.iter().map(|&(k, _)| at(&re, k)).collect(),
+            attenuation: rule.nodes.iter().map(|&(k, _)| at(&im, k)).collect(),
+        }
+    }
 }
 
 thread_local! {
@@ -133,10 +183,12 @@ fn work() -> Pooled<Work> {
             omega: Vec::new(),
             norms: Vec::new(),
             q: [None; MAX_NODES],
+            chirped: Vec::new(),
         })
     });
     w.placed.clear();
     w.omega.clear();
+    w.chirped.clear();
     w.q = [None; MAX_NODES];
     w
 }
@@ -184,7 +236,13 @@ pub fn integrate(
         w.omega.resize(start + n, [C64::new(0.0, 0.0); 3]);
         let placed = w.placed[p];
         let group = &layouts[placed.lobe].groups[placed.group];
-        it.shares(&placed, group, &w.q, &mut w.omega[start..start + n]);
+        it.shares(
+            &placed,
+            group,
+            &w.q,
+            &mut w.chirped,
+            &mut w.omega[start..start + n],
+        );
     }
     let tail_level = s.amplitudes.level_for(plan.tail_strength);
     let mut acc = [[Matrix4::<C64>::zeros(); 2]; 3];
@@ -444,10 +502,11 @@ impl Integration<'_, '_> {
         p: &Placed,
         g: &Group,
         q: &[Option<[C64; 4]>; MAX_NODES],
+        chirped: &mut Vec<TraversalPhases>,
         out: &mut [[C64; 3]],
     ) {
         let Some(level) = p.level else {
-            return self.dense(p, g, q, out);
+            return self.dense(p, g, q, chirped, out);
         };
         let (k0, a) = fringe::band();
         let d = self.s.plate.thickness_nm;
@@ -496,32 +555,25 @@ impl Integration<'_, '_> {
         p: &Placed,
         g: &Group,
         q: &[Option<[C64; 4]>; MAX_NODES],
+        chirped: &mut Vec<TraversalPhases>,
         out: &mut [[C64; 3]],
     ) {
         let (k0, a) = fringe::band();
         let d = self.s.plate.thickness_nm;
         let lv = nodes::level(PHASE_LEVEL);
-        let sample = |im: bool| -> Vec<f64> {
-            lv.in_finest
-                .iter()
-                .map(|&j| {
-                    let x = q[j].expect("the phase level's phases are computed");
-                    (0..4)
-                        .map(|m| {
-                            if im {
-                                f64::from(g.sum[m]) * x[m].im
-                            } else {
-                                f64::from(g.delta[m]) * x[m].re
-                            }
-                        })
-                        .sum()
-                })
-                .collect()
-        };
-        let (phase, loss) = (
-            nodes::chebyshev(&sample(false)),
-            nodes::chebyshev(&sample(true)),
-        );
+        let delta = g.delta.map(f64::from);
+        let sum = g.sum.map(f64::from);
+        let dot =
+            |x: &[f64; 4], y: &[f64; 4]| x[0] * y[0] + x[1] * y[1] + x[2] * y[2] + x[3] * y[3];
+        let samples: Vec<f64> = lv
+            .in_finest
+            .iter()
+            .map(|&j| {
+                let x = q[j].expect("the phase level's phases are computed");
+                dot(&delta, &x.map(|v| v.re))
+            })
+            .collect();
+        let phase = nodes::chebyshev(&samples);
         // The fastest local fringe, d(k d f(t))/dk = d (f + k f'(t)/a), over the band.
         let fastest = (0..=16)
             .map(|s| {
@@ -539,13 +591,19 @@ impl Integration<'_, '_> {
             })
             .unwrap_or(shared::LADDER[shared::LADDER.len() - 1]);
         let rule = shared::rule(self.set, points);
+        let table = match chirped.iter().position(|t| t.points == rule.nodes.len()) {
+            Some(i) => &chirped[i],
+            None => {
+                chirped.push(TraversalPhases::new(self.s, self.set, points, q));
+                chirped.last().expect("just pushed")
+            }
+        };
         let bases = shared::node_basis(self.set, points, p.amplitude_level);
         let n = LEVELS[p.amplitude_level];
-        for (&(k, w), basis) in rule.nodes.iter().zip(bases) {
-            let t = C64::new((k - k0) / a, 0.0);
-            let phi = k * d * nodes::chebyshev_at(&phase, t).re;
-            let alpha = k * d * nodes::chebyshev_at(&loss, t).re;
-            let factor = C64::from_polar((-alpha).exp(), phi);
+        let rows = rule.nodes.iter().zip(bases);
+        for (((_, w), basis), (phi, alpha)) in rows.zip(table.phase.iter().zip(&table.attenuation))
+        {
+            let factor = C64::from_polar((-dot(&sum, alpha)).exp(), dot(&delta, phi));
             let fw = [factor * w[0], factor * w[1], factor * w[2]];
             for (o, l) in out.iter_mut().zip(&basis[..n]) {
                 for c in 0..3 {
