@@ -55,11 +55,21 @@ except for the channel render: see (d)):
    rectangles, against ``thindielectric`` int_ior 1.544 between the same polarisers; the panes
    as 3 mm photoelastic plates (eta_o = 1.5, ``birefringence`` 2e-4) between them, against
    ``thindielectric`` 1.5; a calcite sphere and cube against ``dielectric`` 1.658 (polarised
-   variant only: a bulk crystal needs one). In scalar_rgb and scalar_spectral_polarized, same
-   spp. Every configuration of a variant is loaded and rendered once, then all are rendered in
-   turn, ``repeats`` rounds (interleaved), with fresh seeds; figure = median time of ours /
-   median time of Mitsuba's. The same loop times the isotropic fast path at scene level
-   (``FAST_PATH_PAIRS``): the glass scenes with eta_e = 1.5 + 1e-9 (optically identical,
+   variants only: a bulk crystal needs one); a glass and a calcite sphere on the floor, light
+   bouncing inside them. In scalar_rgb, llvm_ad_rgb, scalar_spectral_polarized and
+   llvm_ad_spectral_polarized, same spp; the quartz plates also as one pass of a channel render
+   (``CHANNEL_PASS``: the room rewritten for sRGB's green as ``render_analytic`` rewrites it, in
+   llvm_ad_mono_polarized), against the same pass with ``thindielectric``. Every configuration
+   of a variant is loaded and rendered once at the timed spp (this compiles the llvm variants'
+   kernels), then all are rendered in turn, ``repeats`` rounds (interleaved), with fresh seeds
+   (a render during which Dr.Jit compiled a kernel is repeated at once with its seed, and the
+   repeat timed: `compiled_none`); figure = median time of ours / median time of Mitsuba's,
+   each against its goal (``OVERHEAD_GOALS``). In the llvm variants ours render in Dr.Jit's
+   evaluated mode (they need it), and so must every render while one of ours exists: the rounds
+   run both in evaluated mode, then ours are deleted and Mitsuba's timed in evaluated against
+   symbolic mode (its default), interleaved; the figure against Mitsuba's symbolic mode is the
+   product of the two ratios (`overhead`). The same loop times the isotropic fast path at scene
+   level (``FAST_PATH_PAIRS``): the glass scenes with eta_e = 1.5 + 1e-9 (optically identical,
    anisotropic to the core) against eta_e = 1.5, in scalar_spectral_polarized.
    ``--only overhead`` measures this part alone and merges it into the existing results.
 
@@ -162,9 +172,11 @@ for _name in CHANNEL_SCENES:
 #: The llvm variant of exact sampling (evaluated mode), in passes of at most this many spp (a
 #: whole 1024-spp render in one wavefront would hold every lane's state at once).
 JIT_VARIANT, JIT_SAMPLES_PER_PASS = "llvm_ad_spectral_polarized", 64
-#: Overhead scene: size, spp, rounds (each render a few tenths of a second, well above the
-#: timer's and the thread pool's noise).
-OVERHEAD_SIZE, OVERHEAD_SPP, OVERHEAD_REPEATS = 48, 32, 5
+#: Overhead scene: size, spp, rounds (each render a few tenths of a second or more, well above
+#: the timer's and the thread pool's noise). 32 px rather than the 48 px of the scalar-only table:
+#: with the llvm variants in evaluated mode (~6 s per render of ours at 48 px on 2 loaded cores)
+#: the table would take over 20 minutes.
+OVERHEAD_SIZE, OVERHEAD_SPP, OVERHEAD_REPEATS = 32, 32, 5
 
 
 def budget(name: str) -> tuple[dict, int]:
@@ -174,7 +186,15 @@ def budget(name: str) -> tuple[dict, int]:
     spp = {m: tuple(b.get(m, v)) for m, v in SPP.items()}
     spp["exact_llvm"] = tuple(b.get("exact_llvm", spp["exact"]))
     return spp, b.get("reference_spp", REFERENCE_SPP)
-OVERHEAD_VARIANTS = ("scalar_rgb", "scalar_spectral_polarized")
+#: The variants (the overhead table's columns, in order). In the llvm variants ours render in
+#: Dr.Jit's evaluated mode, the one they run in (``mitsuba_birefringent.evaluated_mode``); the
+#: figure is against Mitsuba's plugins in their default symbolic mode (`overhead`).
+OVERHEAD_VARIANTS = ("scalar_rgb", "llvm_ad_rgb", "scalar_spectral_polarized",
+                     "llvm_ad_spectral_polarized", "llvm_ad_mono_polarized")
+#: The variants whose rooms are one pass of a channel render (``render_analytic``): the room
+#: rewritten for one colour channel as its pass does (``ChannelScene``; our plates integrate
+#: over the channel), here sRGB's green, and rendered in the variant of its passes.
+CHANNEL_PASS = {"llvm_ad_mono_polarized": "srgb-d65:G"}
 
 
 def load_average() -> list[float] | None:
@@ -698,9 +718,12 @@ class Pair(typing.NamedTuple):
         return self.ours.split("/")[1].split("_")[0]
 
 
-BOTH = OVERHEAD_VARIANTS
+#: Plates and isotropic solids: in the rgb and spectral polarized variants, scalar and llvm.
+BOTH = ("scalar_rgb", "llvm_ad_rgb", "scalar_spectral_polarized", "llvm_ad_spectral_polarized")
 #: A bulk birefringent crystal needs a polarised variant (plugin/README.md).
-POLARIZED = ("scalar_spectral_polarized",)
+POLARIZED = ("scalar_spectral_polarized", "llvm_ad_spectral_polarized")
+#: The quartz plates also as one pass of a channel render.
+PLATES = (*BOTH, *CHANNEL_PASS)
 #: The rows of the overhead table: ours against the Mitsuba plugin a user would use instead, in
 #: the same room, with the same spp and variant.
 OVERHEAD_PAIRS = {
@@ -711,7 +734,7 @@ OVERHEAD_PAIRS = {
         "isotropic", "glass_solids/birefringent", "glass_solids/dielectric", BOTH,
         "glass sphere and cube (eta_o = eta_e = 1.5) vs `dielectric` 1.5"),
     **{f"anisotropic/quartz_plates_{d}um": Pair(
-        "anisotropic", f"quartz_plates/thinbirefringent_{d}um", "quartz_plates/thindielectric", BOTH,
+        "anisotropic", f"quartz_plates/thinbirefringent_{d}um", "quartz_plates/thindielectric", PLATES,
         f"3 quartz plates of {d} um between crossed polarisers vs `thindielectric` {QUARTZ_N_O}")
        for d in QUARTZ_UM},
     "anisotropic/photoelastic_plates_3mm": Pair(
@@ -734,40 +757,178 @@ OVERHEAD_PAIRS = {
 FAST_PATH_PAIRS = {
     "isotropic_fast_path_thin": Pair(
         "anisotropic", "glass_panes/thinbirefringent_aniso_1e-9", "glass_panes/thinbirefringent",
-        POLARIZED, "3 glass panes, eta_e = 1.5 + 1e-9 vs 1.5"),
+        ("scalar_spectral_polarized",), "3 glass panes, eta_e = 1.5 + 1e-9 vs 1.5"),
     "isotropic_fast_path_bulk": Pair(
         "anisotropic", "glass_solids/birefringent_aniso_1e-9", "glass_solids/birefringent",
-        POLARIZED, "glass sphere and cube, eta_e = 1.5 + 1e-9 vs 1.5"),
+        ("scalar_spectral_polarized",), "glass sphere and cube, eta_e = 1.5 + 1e-9 vs 1.5"),
 }
+
+
+#: The goals of the overhead table (issue 20), in one place: per kind of row, what it covers and
+#: the largest ratio ours / Mitsuba's it allows. results.json gives each row's goal per variant
+#: (`overhead_goal`), and docs/benchmarks.md prints them from there.
+OVERHEAD_GOALS = {
+    "isotropic": ("isotropic parameters (eta_o = eta_e), every variant", 1.3),
+    "plate_rgb": ("birefringent plates in scalar_rgb and llvm_ad_rgb", 4.0),
+    "plate_spectral": ("birefringent plates in the spectral polarized variants", 2.0),
+    "plate_channel_pass": ("birefringent plates, one pass of a channel render", 3.0),
+    "crystal": ("birefringent bulk crystals", 2.0),
+}
+
+
+def overhead_goal(pair: Pair, variant: str) -> str:
+    """The key of OVERHEAD_GOALS that `pair` is judged by in `variant`."""
+    if pair.kind == "isotropic":
+        return "isotropic"
+    if pair.plugin == "birefringent":
+        return "crystal"
+    if variant in CHANNEL_PASS:
+        return "plate_channel_pass"
+    return "plate_spectral" if "spectral" in variant else "plate_rgb"
+
+
+def overhead_room(mi, name: str, variant: str) -> dict:
+    """The room of configuration `name` for `variant`: in a variant of CHANNEL_PASS, the pass of
+    its channel as ``render_analytic`` renders it (``analytic.channel_passes``)."""
+    d = room(mi, CONFIGS[name](mi))
+    if variant not in CHANNEL_PASS:
+        return d
+    from mitsuba_birefringent.analytic import CHANNELS, channel_passes
+
+    weights, channel = CHANNEL_PASS[variant].split(":")
+    return channel_passes(d, weights)[CHANNELS[weights].index(channel)]
+
+
+def evaluated(variant: str) -> bool:
+    """Whether the timed rounds of `variant` render in Dr.Jit's evaluated mode: in the llvm
+    variants, ours because they need it, and Mitsuba's plugins too, since while a scene of ours
+    exists in the process a symbolic render of any scene fails (plugin/mitsuba_birefringent/jit.py);
+    Mitsuba's default, symbolic mode is timed after ours are deleted (`symbolic_factor`)."""
+    return variant.startswith("llvm_")
+
+
+def render_in_mode(mi, scene, spp: int, seed: int, evaluated_mode: bool) -> float:
+    """Wall time of `render` (the image read back, which waits for Dr.Jit's kernels), in
+    evaluated mode if `evaluated_mode`, else in the flags' defaults (symbolic)."""
+    import mitsuba_birefringent
+
+    if not evaluated_mode:
+        return render(mi, scene, spp, seed)[1]
+    with mitsuba_birefringent.evaluated_mode():
+        return render(mi, scene, spp, seed)[1]
+
+
+class KernelCount:
+    """Dr.Jit kernels launched, and compiled (not found in its cache) with their compile time in
+    ms, while in the block (a JIT variant; none in a scalar one)."""
+
+    def __enter__(self):
+        import drjit as dr
+
+        self.dr = dr
+        self.was = dr.flag(dr.JitFlag.KernelHistory)
+        dr.set_flag(dr.JitFlag.KernelHistory, True)
+        dr.kernel_history()  # clears it
+        return self
+
+    def __exit__(self, *exc):
+        dr = self.dr
+        history = [k for k in dr.kernel_history() if k.get("type") == dr.KernelType.JIT]
+        compiled = [k for k in history if not k.get("cache_hit")]
+        self.launched, self.compiled = len(history), len(compiled)
+        self.compile_ms = sum(k.get("codegen_time", 0.0) + k.get("backend_time", 0.0) for k in compiled)
+        dr.set_flag(dr.JitFlag.KernelHistory, self.was)
+
+
+def compiled_none(mi, scene, seed: int, evaluated_mode: bool, log: dict) -> float:
+    """The time of a render of `scene` (`render_in_mode`) during which Dr.Jit compiled no kernel:
+    a render that compiled one (in evaluated mode a kernel's code can depend on how many lanes
+    reach a call, so a new seed may need a new kernel) is repeated at once with the same seed,
+    whose kernels are then cached, up to twice. `log` counts the kernels of the kept renders and
+    of the repeated ones."""
+    for _ in range(3):
+        with KernelCount() as k:
+            seconds = render_in_mode(mi, scene, OVERHEAD_SPP, seed, evaluated_mode)
+        if not k.compiled:
+            break
+        log["repeated_renders"] += 1
+        log["repeated_compile_ms"] += k.compile_ms
+    log["launched"] += k.launched
+    log["compiled"] += k.compiled  # in the kept renders: 0 unless three attempts compiled
+    return seconds
+
+
+def timed_rounds(mi, scenes: dict, modes: dict, repeats: int) -> tuple[dict, dict]:
+    """Each of `scenes` rendered once at OVERHEAD_SPP in its mode (`modes`: evaluated or not;
+    in an llvm variant this compiles Dr.Jit's kernels), then `repeats` rounds rendering each in
+    turn with fresh seeds (`compiled_none`): the times per scene, and the kernels of the rounds."""
+    for name, scene in scenes.items():
+        render_in_mode(mi, scene, OVERHEAD_SPP, 0, modes[name])
+    times = {name: [] for name in scenes}
+    log = {"launched": 0, "compiled": 0, "repeated_renders": 0, "repeated_compile_ms": 0.0}
+    for rep in range(repeats):
+        for name, scene in scenes.items():
+            times[name].append(compiled_none(mi, scene, 10 * rep + 1, modes[name], log))
+    return times, log
+
+
+def symbolic_factor(mi, scenes: dict, repeats: int) -> dict:
+    """Mitsuba's `scenes` (no plugin of ours left in the process) rendered in evaluated and in
+    symbolic mode, interleaved: per scene the two lists of times, their medians' ratio
+    evaluated / symbolic, and the kernels of the rounds."""
+    both = {(name, mode): scene for name, scene in scenes.items() for mode in ("evaluated", "symbolic")}
+    times, kernels = timed_rounds(mi, both, {k: k[1] == "evaluated" for k in both}, repeats)
+    out = {name: {mode: times[(name, mode)] for mode in ("evaluated", "symbolic")} for name in scenes}
+    for t in out.values():
+        t["factor"] = statistics.median(t["evaluated"]) / statistics.median(t["symbolic"])
+    return {"scenes": out, "kernels_while_timed": kernels}
 
 
 def overhead(repeats: int) -> dict:
     """Every pair of OVERHEAD_PAIRS and FAST_PATH_PAIRS in each of OVERHEAD_VARIANTS: every
-    configuration a variant needs loaded and warmed up, then `repeats` rounds in which each is
-    rendered once (fresh seeds per round)."""
+    configuration a variant needs loaded and rendered once at the timed spp, then `repeats`
+    interleaved rounds (`timed_rounds`); ratios ours / Mitsuba's of the median times. In the
+    llvm variants every configuration renders in evaluated mode (`evaluated`); then ours are
+    deleted and Mitsuba's timed in evaluated against symbolic mode (`symbolic_factor`): the
+    ratio against Mitsuba's default mode is the product of the two interleaved ratios."""
+    import gc
+
     pairs = {**OVERHEAD_PAIRS, **FAST_PATH_PAIRS}
     out = {}
     for variant in OVERHEAD_VARIANTS:
         mi = set_variant(variant)
         here = {k: p for k, p in pairs.items() if variant in p.variants}
         names = list(dict.fromkeys(n for p in here.values() for n in (p.theirs, p.ours)))
-        scenes = {}
-        for name in names:
-            scenes[name] = mi.load_dict(room(mi, CONFIGS[name](mi)))
-            mi.render(scenes[name], spp=1, seed=0)  # warm-up
-        times = {name: [] for name in scenes}
-        for rep in range(repeats):
-            for name, scene in scenes.items():
-                times[name].append(render(mi, scene, OVERHEAD_SPP, seed=10 * rep + 1)[1])
+        scenes = {name: mi.load_dict(overhead_room(mi, name, variant)) for name in names}
+        times, kernels = timed_rounds(mi, scenes, dict.fromkeys(names, evaluated(variant)), repeats)
         med = {name: statistics.median(t) for name, t in times.items()}
         ratios = {k: med[p.ours] / med[p.theirs] for k, p in here.items()}
-        print(f"overhead, {variant} (median s):")
+        result = {"median_seconds": med, "seconds": times, "ratios": ratios,
+                  "evaluated_mode": evaluated(variant), "kernels_while_timed": kernels}
+        print(f"overhead, {variant} (median s; kernels while timed: {kernels}):")
         for name, t in med.items():
             print(f"  {name:48s} {t:8.3f}")
-        print("  ratios:")
+        if result["evaluated_mode"]:
+            theirs = {p.theirs for p in here.values()}
+            for name in names:
+                if name not in theirs:
+                    del scenes[name]  # no plugin of ours may exist during a symbolic render
+            gc.collect()
+            sym = symbolic_factor(mi, scenes, repeats)
+            result["mitsuba_evaluated_over_symbolic"] = sym
+            result["ratios_vs_evaluated"] = ratios
+            ratios = {k: r * sym["scenes"][here[k].theirs]["factor"] for k, r in ratios.items()}
+            result["ratios"] = ratios
+            print(f"  Mitsuba's, evaluated / symbolic mode (kernels while timed: "
+                  f"{sym['kernels_while_timed']}):")
+            for name, t in sym["scenes"].items():
+                print(f"  {name:48s} {t['factor']:8.2f}")
+        print("  ratios" + (" (against Mitsuba's symbolic mode)" if result["evaluated_mode"] else "") + ":")
         for k, r in ratios.items():
             print(f"  {k:48s} {r:8.2f}")
-        out[variant] = {"median_seconds": med, "seconds": times, "ratios": ratios}
+        out[variant] = result
+        del scenes
+        gc.collect()
     return out
 
 
@@ -779,10 +940,20 @@ def overhead_summary(over: dict, repeats: int, measured: dict) -> dict:
     """results.json's "overhead": how it was measured, and per row of OVERHEAD_PAIRS its kind,
     scene and ratio ours / Mitsuba's per variant."""
     rows = {k: {"kind": p.kind, "plugin": p.plugin, "what": p.what, "ours": p.ours, "theirs": p.theirs,
-                "ratio": {v: over[v]["ratios"][k] for v in p.variants}}
+                "ratio": {v: over[v]["ratios"][k] for v in p.variants},
+                "goal": {v: OVERHEAD_GOALS[overhead_goal(p, v)][1] for v in p.variants},
+                "ratio_vs_evaluated": {v: over[v]["ratios_vs_evaluated"][k] for v in p.variants
+                                       if "ratios_vs_evaluated" in over[v]}}
             for k, p in OVERHEAD_PAIRS.items()}
     settings = {"size": OVERHEAD_SIZE, "spp": OVERHEAD_SPP, "repeats": repeats,
-                "integrator": "path, max_depth 8", "variants": list(OVERHEAD_VARIANTS)}
+                "integrator": "path, max_depth 8", "variants": list(OVERHEAD_VARIANTS),
+                "channel_pass": CHANNEL_PASS,
+                "goals": {g: {"what": what, "at_most": bound} for g, (what, bound) in OVERHEAD_GOALS.items()},
+                "evaluated_mode": [v for v in OVERHEAD_VARIANTS if over[v]["evaluated_mode"]],
+                "kernels_while_timed": {v: over[v]["kernels_while_timed"] for v in OVERHEAD_VARIANTS},
+                "mitsuba_evaluated_over_symbolic": {
+                    v: {n: t["factor"] for n, t in over[v]["mitsuba_evaluated_over_symbolic"]["scenes"].items()}
+                    for v in OVERHEAD_VARIANTS if over[v]["evaluated_mode"]}}
     return {"measured": measured, "settings": settings, "rows": rows}
 
 

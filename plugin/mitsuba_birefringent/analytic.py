@@ -61,10 +61,7 @@ def render_analytic(scene: dict, spp: int = 16, weights: str = "srgb-d65",
         raise ValueError(f"spp must be a positive integer, got {spp!r}")
     if weights not in CHANNELS:
         raise ValueError(f"weights must be one of {', '.join(CHANNELS)}, got {weights!r}")
-    to_srgb = np.array(channel_matrix(weights))
-    from_srgb = np.linalg.inv(to_srgb)
-    passes = [ChannelScene(weights, f"{weights}:{c}", k, from_srgb).rewrite(scene)
-              for k, c in enumerate(CHANNELS[weights])]  # every refusal before any render
+    passes = channel_passes(scene, weights)  # every refusal before any render
     warn_where_inexact(scene)
     previous = mi.variant()
     mi.set_variant(VARIANT)
@@ -74,7 +71,14 @@ def render_analytic(scene: dict, spp: int = 16, weights: str = "srgb-d65",
     finally:
         if previous is not None:
             mi.set_variant(previous)
-    return assemble(images, to_srgb)
+    return assemble(images, np.array(channel_matrix(weights)))
+
+
+def channel_passes(scene: dict, weights: str) -> list[dict]:
+    """The scene dict of each channel's pass, in the order of ``CHANNELS[weights]``."""
+    from_srgb = np.linalg.inv(np.array(channel_matrix(weights)))
+    return [ChannelScene(weights, f"{weights}:{c}", k, from_srgb).rewrite(scene)
+            for k, c in enumerate(CHANNELS[weights])]
 
 
 def render_pass(scene: dict, spp: int, seed: int) -> dict[str, np.ndarray]:

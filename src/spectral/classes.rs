@@ -59,8 +59,8 @@ const PHASE_LEVEL: usize = 4;
 /// pairs fall below [`ORDER_TAIL`] (across orders: `ρⁿ` times the visibility of `n` round
 /// trips; within an order, where mode conversions keep paths of equal counts coherent:
 /// `ρ^{2n}`), at most [`MAX_ORDER`] (beyond, the tail takes the rest: plates near grazing
-/// incidence, where the round trip reflects nearly everything; `tests/spectral_grazing.rs`
-/// measures that error). `None` if the orders do not converge (`ρ ≥ 1`).
+/// incidence, where the round trip reflects nearly everything; docs/physics.md §4, "Known
+/// limitations", gives that error as measured). `None` if the orders do not converge (`ρ ≥ 1`).
 pub fn plan(s: &Survey, set: WeightSet) -> Option<Plan> {
     let rho = s.rho;
     // `ρ ≥ 1` or NaN: the orders do not converge.
@@ -122,52 +122,80 @@ struct Work {
     norms: Vec<f64>,
     /// `Q` per traversal at each finest-level node that a phase uses.
     q: [Option<[C64; 4]>; MAX_NODES],
+    /// The traversals' phase series of the query (computed by its first chirped group).
+    series: Option<TraversalSeries>,
     /// The traversals' phases on the shared rules the chirped groups use (one per rung).
     chirped: Vec<TraversalPhases>,
 }
 
+/// Nodes of [`PHASE_LEVEL`].
+const PHASE_NODES: usize = LEVELS[PHASE_LEVEL];
+
+/// The Chebyshev series of the four traversals' `Re Q_m` and `Im Q_m` through their exact
+/// values at the nodes of [`PHASE_LEVEL`] (`Q` is analytic around the band: they converge
+/// geometrically); a group's phase series is `Δ ·` these, its attenuation's `Σ ·` these.
+#[derive(Clone, Copy)]
+struct TraversalSeries {
+    re: [[f64; PHASE_NODES]; 4],
+    im: [[f64; PHASE_NODES]; 4],
+}
+
+impl TraversalSeries {
+    fn new(q: &[Option<[C64; 4]>; MAX_NODES]) -> Self {
+        let lv = nodes::level(PHASE_LEVEL);
+        let series = |m: usize, im: bool| -> [f64; PHASE_NODES] {
+            let v: [f64; PHASE_NODES] = std::array::from_fn(|i| {
+                let x = q[lv.in_finest[i]].expect("the phase level's phases are computed")[m];
+                if im {
+                    x.im
+                } else {
+                    x.re
+                }
+            });
+            let mut c = [0.0; PHASE_NODES];
+            nodes::chebyshev_into(&v, &mut c);
+            c
+        };
+        TraversalSeries {
+            re: std::array::from_fn(|m| series(m, false)),
+            im: std::array::from_fn(|m| series(m, true)),
+        }
+    }
+
+    /// `Δ · c` of four series.
+    fn combine(c: &[[f64; PHASE_NODES]; 4], delta: &[f64; 4]) -> [f64; PHASE_NODES] {
+        std::array::from_fn(|i| (0..4).map(|m| delta[m] * c[m][i]).sum())
+    }
+}
+
 /// The four traversals' phases `k d Re Q_m(k)` and attenuations `k d Im Q_m(k)` at every point
-/// of one shared rule, from their Chebyshev interpolants through the exact values at the nodes
-/// of [`PHASE_LEVEL`]: evaluated once per query and rule, then every chirped group's phase is
-/// `Δ · phase` and its attenuation `Σ · attenuation` ([`Integration::dense`]).
+/// of one shared rule, from [`TraversalSeries`]: evaluated once per query and rule, then every
+/// chirped group's phase is `Δ · phase` and its attenuation `Σ · attenuation`
+/// ([`Integration::dense`]). The tables of a thread are kept between queries (`fresh` marks
+/// those of the current one), so a query refills them without allocating.
 struct TraversalPhases {
     points: usize,
+    fresh: bool,
     phase: Vec<[f64; 4]>,
     attenuation: Vec<[f64; 4]>,
 }
 
 impl TraversalPhases {
-    fn new(s: &Survey, set: WeightSet, points: usize, q: &[Option<[C64; 4]>; MAX_NODES]) -> Self {
+    fn fill(&mut self, s: &Survey, rule: &shared::Rule, series: &TraversalSeries) {
         let (k0, a) = fringe::band();
         let d = s.plate.thickness_nm;
-        let lv = nodes::level(PHASE_LEVEL);
-        let series = |m: usize, im: bool| -> Vec<f64> {
-            let v: Vec<f64> = lv
-                .in_finest
-                .iter()
-                .map(|&j| {
-                    let x = q[j].expect("the phase level's phases are computed")[m];
-                    if im {
-                        x.im
-                    } else {
-                        x.re
-                    }
-                })
-                .collect();
-            nodes::chebyshev(&v)
-        };
-        let re: [Vec<f64>; 4] = std::array::from_fn(|m| series(m, false));
-        let im: [Vec<f64>; 4] = std::array::from_fn(|m| series(m, true));
-        let rule = shared::rule(set, points);
-        let at = |c: &[Vec<f64>; 4], k: f64| -> [f64; 4] {
+        let at = |c: &[[f64; PHASE_NODES]; 4], k: f64| -> [f64; 4] {
             let t = (k - k0) / a;
             std::array::from_fn(|m| k * d * nodes::chebyshev_at(&c[m], t))
         };
-        TraversalPhases {
-            points: rule.nodes.len(),
-            phase: rule.nodes.iter().map(|&(k, _)| at(&re, k)).collect(),
-            attenuation: rule.nodes.iter().map(|&(k, _)| at(&im, k)).collect(),
-        }
+        self.phase.clear();
+        self.attenuation.clear();
+        self.phase
+            .extend(rule.nodes.iter().map(|&(k, _)| at(&series.re, k)));
+        self.attenuation
+            .extend(rule.nodes.iter().map(|&(k, _)| at(&series.im, k)));
+        self.points = rule.nodes.len();
+        self.fresh = true;
     }
 }
 
@@ -183,12 +211,14 @@ fn work() -> Pooled<Work> {
             omega: Vec::new(),
             norms: Vec::new(),
             q: [None; MAX_NODES],
+            series: None,
             chirped: Vec::new(),
         })
     });
     w.placed.clear();
     w.omega.clear();
-    w.chirped.clear();
+    w.series = None;
+    w.chirped.iter_mut().for_each(|t| t.fresh = false);
     w.q = [None; MAX_NODES];
     w
 }
@@ -240,6 +270,7 @@ pub fn integrate(
             &placed,
             group,
             &w.q,
+            &mut w.series,
             &mut w.chirped,
             &mut w.omega[start..start + n],
         );
@@ -502,11 +533,13 @@ impl Integration<'_, '_> {
         p: &Placed,
         g: &Group,
         q: &[Option<[C64; 4]>; MAX_NODES],
+        series: &mut Option<TraversalSeries>,
         chirped: &mut Vec<TraversalPhases>,
         out: &mut [[C64; 3]],
     ) {
         let Some(level) = p.level else {
-            return self.dense(p, g, q, chirped, out);
+            let series = *series.get_or_insert_with(|| TraversalSeries::new(q));
+            return self.dense(p, g, &series, chirped, out);
         };
         let (k0, a) = fringe::band();
         let d = self.s.plate.thickness_nm;
@@ -554,26 +587,17 @@ impl Integration<'_, '_> {
         &self,
         p: &Placed,
         g: &Group,
-        q: &[Option<[C64; 4]>; MAX_NODES],
+        series: &TraversalSeries,
         chirped: &mut Vec<TraversalPhases>,
         out: &mut [[C64; 3]],
     ) {
         let (k0, a) = fringe::band();
         let d = self.s.plate.thickness_nm;
-        let lv = nodes::level(PHASE_LEVEL);
         let delta = g.delta.map(f64::from);
         let sum = g.sum.map(f64::from);
         let dot =
             |x: &[f64; 4], y: &[f64; 4]| x[0] * y[0] + x[1] * y[1] + x[2] * y[2] + x[3] * y[3];
-        let samples: Vec<f64> = lv
-            .in_finest
-            .iter()
-            .map(|&j| {
-                let x = q[j].expect("the phase level's phases are computed");
-                dot(&delta, &x.map(|v| v.re))
-            })
-            .collect();
-        let phase = nodes::chebyshev(&samples);
+        let phase = TraversalSeries::combine(&series.re, &delta);
         // The fastest local fringe, d(k d f(t))/dk = d (f + k f'(t)/a), over the band.
         let fastest = (0..=16)
             .map(|s| {
@@ -591,13 +615,22 @@ impl Integration<'_, '_> {
             })
             .unwrap_or(shared::LADDER[shared::LADDER.len() - 1]);
         let rule = shared::rule(self.set, points);
-        let table = match chirped.iter().position(|t| t.points == rule.nodes.len()) {
-            Some(i) => &chirped[i],
+        let i = match chirped.iter().position(|t| t.points == rule.nodes.len()) {
+            Some(i) => i,
             None => {
-                chirped.push(TraversalPhases::new(self.s, self.set, points, q));
-                chirped.last().expect("just pushed")
+                chirped.push(TraversalPhases {
+                    points: rule.nodes.len(),
+                    fresh: false,
+                    phase: Vec::with_capacity(rule.nodes.len()),
+                    attenuation: Vec::with_capacity(rule.nodes.len()),
+                });
+                chirped.len() - 1
             }
         };
+        if !chirped[i].fresh {
+            chirped[i].fill(self.s, rule, series);
+        }
+        let table = &chirped[i];
         let bases = shared::node_basis(self.set, points, p.amplitude_level);
         let n = LEVELS[p.amplitude_level];
         let rows = rule.nodes.iter().zip(bases);

@@ -162,19 +162,25 @@ pub fn level(level: usize) -> &'static Level {
 /// The Chebyshev coefficients `c_m` of the polynomial through the values `v_i` at the Lobatto
 /// nodes of `v.len()` points (`p(t) = Σ_m c_m T_m(t)`; the discrete cosine transform of type I).
 pub fn chebyshev(v: &[f64]) -> Vec<f64> {
+    let mut c = vec![0.0; v.len()];
+    chebyshev_into(v, &mut c);
+    c
+}
+
+/// [`chebyshev`] into `out` (no allocation).
+pub fn chebyshev_into(v: &[f64], out: &mut [f64]) {
     let n = v.len();
     if n == 1 {
-        return v.to_vec();
+        out[0] = v[0];
+        return;
     }
     let l = LEVELS
         .iter()
         .position(|&m| m == n)
         .expect("values on the nodes of a level");
-    level(l)
-        .dct
-        .iter()
-        .map(|row| row.iter().zip(v).map(|(w, x)| w * x).sum())
-        .collect()
+    for (o, row) in out.iter_mut().zip(&level(l).dct) {
+        *o = row.iter().zip(v).map(|(w, x)| w * x).sum();
+    }
 }
 
 /// `(p(t), p'(t), p''(t))` of `p = Σ_m c_m T_m` (Chebyshev recurrences for `T_m` and its

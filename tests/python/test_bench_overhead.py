@@ -2,12 +2,15 @@
 each pair are the same scene (sensor, film, sampler, spp, integrator, walls, light, shapes,
 transforms, polarisers) and differ only in the BSDF under test, which is the plugin the row
 names, of the kind it is labelled with (isotropic or anisotropic as the plugin itself reports
-it), against the Mitsuba plugin a user would use instead; and both rooms load in each variant
-the pair is timed in. Only scene descriptions are built and loaded here; nothing is rendered.
+it), against the Mitsuba plugin a user would use instead; both rooms load in each variant
+the pair is timed in; the channel-pass rooms are the pass render_analytic renders; and each row
+is judged by the goal of its kind. Only scene descriptions are built and loaded here; nothing is
+rendered.
 """
 
 import importlib.util
 import pathlib
+import warnings
 
 import numpy as np
 import pytest
@@ -66,8 +69,8 @@ CASES = [(key, variant) for key, p in PAIRS.items() for variant in p.variants]
 def test_pair_differs_only_in_the_bsdf(key, variant):
     p = PAIRS[key]
     mi = B.set_variant(variant)
-    ours_scene = B.room(mi, B.CONFIGS[p.ours](mi))
-    theirs_scene = B.room(mi, B.CONFIGS[p.theirs](mi))
+    ours_scene = B.overhead_room(mi, p.ours, variant)
+    theirs_scene = B.overhead_room(mi, p.theirs, variant)
     ours_rest, ours = split(ours_scene)
     theirs_rest, theirs = split(theirs_scene)
     assert ours_rest == theirs_rest
@@ -104,3 +107,62 @@ def test_quartz_rows_have_their_thicknesses():
         _, plates = split(B.room(mi, B.CONFIGS[p.ours](mi)))
         assert {b["thickness"] for b in plates} == {float(d)}
         assert {b["material"] for b in plates} == {"quartz"}
+
+
+@pytest.mark.parametrize("variant", list(B.CHANNEL_PASS))
+def test_channel_pass_rooms_are_the_pass_render_analytic_renders(variant, monkeypatch):
+    """The channel-pass room is the scene render_analytic loads for its channel (captured from a
+    call of it), and it is a rewritten channel scene: our plates carry the channel, the film is
+    one-channel, the emitter's D65 is the channel's white."""
+    import mitsuba_birefringent
+    from mitsuba_birefringent import analytic
+
+    mi = B.set_variant(variant)
+    key = "anisotropic/quartz_plates_50um"
+    room = B.room(mi, B.CONFIGS[B.OVERHEAD_PAIRS[key].ours](mi))
+    loaded = []
+    monkeypatch.setattr(analytic, "render_pass", lambda d, spp, seed: loaded.append(d) or {})
+    monkeypatch.setattr(analytic, "assemble", lambda images, to_srgb: None)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # it warns of the three plates (side by side here: exact)
+        mitsuba_birefringent.render_analytic(room, spp=1)
+    weights, channel = B.CHANNEL_PASS[variant].split(":")
+    assert analytic.VARIANT == variant
+    expected = loaded[analytic.CHANNELS[weights].index(channel)]
+    ours = B.overhead_room(mi, B.OVERHEAD_PAIRS[key].ours, variant)
+    assert plain(ours) == plain(expected)
+    _, plates = split(ours)
+    assert {b["channel"] for b in plates} == {B.CHANNEL_PASS[variant]}
+    assert ours["sensor"]["film"]["pixel_format"] == "luminance"
+    assert ours["lamp"]["emitter"]["radiance"]["type"] == "uniform"
+
+
+def test_goals_per_row_kind():
+    """The issue's goals: isotropic <= 1.3; birefringent plates <= 4 in the rgb variants, <= 2 in
+    the spectral polarized ones, <= 3 for a channel pass; bulk crystals <= 2."""
+    expected = {("anisotropic/quartz_plates_50um", "scalar_rgb"): 4.0,
+                ("anisotropic/quartz_plates_50um", "llvm_ad_rgb"): 4.0,
+                ("anisotropic/quartz_plates_50um", "scalar_spectral_polarized"): 2.0,
+                ("anisotropic/photoelastic_plates_3mm", "llvm_ad_spectral_polarized"): 2.0,
+                ("anisotropic/quartz_plates_50um", "llvm_ad_mono_polarized"): 3.0,
+                ("anisotropic/calcite_solids", "llvm_ad_spectral_polarized"): 2.0,
+                ("anisotropic/bouncing_calcite_sphere", "scalar_spectral_polarized"): 2.0,
+                ("isotropic/bouncing_glass_sphere", "llvm_ad_rgb"): 1.3,
+                ("isotropic/glass_panes", "scalar_spectral_polarized"): 1.3}
+    for (key, variant), bound in expected.items():
+        p = B.OVERHEAD_PAIRS[key]
+        assert variant in p.variants
+        assert B.OVERHEAD_GOALS[B.overhead_goal(p, variant)][1] == bound
+
+
+def test_llvm_and_bouncing_rows_are_timed():
+    """Every row of the scalar variants is also timed in its llvm counterpart; the quartz plates
+    also as a channel pass; the bouncing crystals in both polarised variants."""
+    for p in B.OVERHEAD_PAIRS.values():
+        for scalar, llvm in (("scalar_rgb", "llvm_ad_rgb"),
+                             ("scalar_spectral_polarized", "llvm_ad_spectral_polarized")):
+            assert (scalar in p.variants) == (llvm in p.variants)
+    for d in B.QUARTZ_UM:
+        assert set(B.CHANNEL_PASS) <= set(B.OVERHEAD_PAIRS[f"anisotropic/quartz_plates_{d}um"].variants)
+    calcite = B.OVERHEAD_PAIRS["anisotropic/bouncing_calcite_sphere"]
+    assert set(calcite.variants) == {"scalar_spectral_polarized", "llvm_ad_spectral_polarized"}
