@@ -258,11 +258,11 @@ pub fn least_attenuation(plate: &Plate, amplitudes: &Amplitudes) -> Option<[f64;
     };
     // Lobatto order: finest node 0 is t = 1 (the short-wave end), the last t = −1.
     let points = [(k0, centre), (k0 + a, ends[0]), (k0 - a, ends[1])];
-    // Evanescent-like where `Re(q²) < 0` (`|Im q| > |Re q|`): in a clear layer exactly where
-    // `q` turns imaginary; in a weakly absorbing one (every `q` complex) where the wave's
-    // attenuation jumps from its absorption to the evanescent decay (a kappa of 1e-20 made the
-    // test `x.im != 0` see no change, and the methods that need smooth amplitudes returned NaN).
-    let evanescent = |q: &[C64; 4]| q.map(|x| x.im.abs() > x.re.abs());
+    // A clear layer's wave turns evanescent where `q` leaves the real axis (a tilted axis's
+    // evanescent e-wave keeps a real part); a weakly absorbing layer's (every `q` complex) where
+    // its decay overtakes its oscillation, `|Im q| > |Re q|` (with a kappa of 1e-20 the first
+    // test alone saw no change, and the methods that need smooth amplitudes returned NaN).
+    let evanescent = |q: &[C64; 4]| q.map(|x| (x.im != 0.0, x.im.abs() > x.re.abs()));
     if points
         .iter()
         .any(|(_, q)| evanescent(q) != evanescent(&centre))
