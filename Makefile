@@ -37,7 +37,11 @@
 #                 survives or no longer applies (tools/mutants.py; MUTANTS=id,id runs only those)
 #   make bench    make setup, then the core benchmark on one core (taskset -c 0) and its plot:
 #                 bench/out/core.json, bench/out/core_error_vs_time.png (several minutes), then
-#                 make bench-scenes, make bench-jit and make bench-gradients
+#                 make bench-scenes, make bench-stack, make bench-jit and make bench-gradients
+#   make bench-stack  layered stacks (examples/bench_stack.rs, one core): a 4-layer stack against
+#                 one plate at one wavelength and over XYZ (issue goals: at most 4x each), and the
+#                 channel integration's colour error on BENCH_STACKS random stacks against dense
+#                 quadrature; bench/out/stack.json
 #   make bench-jit  the plugins in the llvm variants (evaluated mode): render time against
 #                 Mitsuba's dielectric/thindielectric and against the scalar variants, peak
 #                 memory; bench/out/jit.json and bench/out/jit.png
@@ -85,7 +89,7 @@ PLUGIN_BUILT := target/release/libmitsuba_birefringent.so
 # site-packages of .venv/ (evaluated when used: the venv may not exist yet when make starts)
 SITE = $(shell $(VPY) -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')
 
-.PHONY: help setup build venv llvm plugin plugin-lib render gallery test test-rust test-python mutants fuzz fuzz-ci bench bench-scenes bench-overhead bench-jit bench-variants bench-gradients fmt lint clean distclean
+.PHONY: help setup build venv llvm plugin plugin-lib render gallery test test-rust test-python mutants fuzz fuzz-ci bench bench-scenes bench-overhead bench-jit bench-variants bench-gradients bench-stack fmt lint clean distclean
 
 help:
 	@sed -n '3,/^$$/s/^# \{0,1\}//p' $(firstword $(MAKEFILE_LIST))
@@ -249,8 +253,18 @@ bench: setup
 	$(TASKSET) $(BENCH_BIN) --validate $(BENCH_PLATES) --out $(BENCH_OUT)/core.json
 	$(VPY) bench/plot_core.py $(BENCH_OUT)/core.json $(BENCH_OUT)/core_error_vs_time.png
 	$(MAKE) --no-print-directory bench-scenes
+	$(MAKE) --no-print-directory bench-stack
 	$(MAKE) --no-print-directory bench-jit
 	$(MAKE) --no-print-directory bench-gradients
+
+# examples/bench_stack.rs: interleaved timings of stacks against plates, and the validation of
+# tests/stack_spectral.rs on BENCH_STACKS random stacks. Pinned to one core like bench.
+BENCH_STACKS ?= 200
+
+bench-stack: setup
+	$(CARGO) build --release --example bench_stack
+	@mkdir -p $(BENCH_OUT)
+	$(TASKSET) target/release/examples/bench_stack --validate $(BENCH_STACKS) --out $(BENCH_OUT)/stack.json
 
 # bench/jit.py: the overhead scenes of bench/scenes.py in every llvm variant in evaluated mode
 # (ours against Mitsuba's own plugins, and against ours in the scalar variants), interleaved

@@ -73,6 +73,7 @@ fn main() {
     let sources = [
         "src/thinbirefringent.cpp",
         "src/birefringent.cpp",
+        "src/birefringentstack.cpp",
         "src/register.cpp",
     ];
     let mut build = cxx_build::bridge("src/lib.rs");
@@ -129,6 +130,7 @@ fn main() {
         "src/last_valid.h",
         "src/scalar_texture.h",
         "src/signed_rgb.h",
+        "src/layer.h",
     ]) {
         println!("cargo:rerun-if-changed={f}");
     }

@@ -17,6 +17,7 @@ pub mod plate;
 pub mod render;
 pub mod scratch;
 pub mod spectral;
+pub mod stack;
 
 pub use error::{Error, ErrorKind, Result};
 pub use num_complex::Complex64 as C64;

@@ -203,3 +203,39 @@ fn zero_thickness_is_the_bare_interface() {
         }
     }
 }
+
+/// A weakly absorbing plate whose e-wave turns evanescent inside the band (calcite's n_e
+/// crosses the incidence parameter 1.489 across the visible) takes the evanescent route, as
+/// the same clear plate does, and agrees with it: a kappa_e of 1e-20 once hid the branch point
+/// from the survey and gave non-finite channels (found by the plugin fuzzer).
+#[test]
+fn a_weakly_absorbing_plate_turning_evanescent_takes_the_evanescent_route() {
+    let plate = |kappa_e: f64| Plate {
+        material: Material::named("calcite", 0.0, kappa_e).unwrap(),
+        birefringence: 0.0,
+        ext: C64::new(1.5168, 0.0),
+        exit: C64::new(1.5168, 0.0),
+        axis: Vector3::x(),
+        thickness_nm: 1000.0,
+    };
+    let frame = PlaneFrame::from_azimuth(std::f64::consts::FRAC_PI_2);
+    let beta = C64::new(1.5168 * 79f64.to_radians().sin(), 0.0);
+    let channels = |p: &Plate| {
+        PlateModel::new(p, frame, beta)
+            .channels(SET, Want::BOTH, Output::Mueller, Accuracy::Perceptual)
+            .unwrap()
+    };
+    let (clear, weak) = (plate(0.0), plate(1e-20));
+    let survey = Survey::new(&weak, frame, beta).unwrap();
+    assert!(matches!(
+        route::choose(&survey, SET).unwrap(),
+        Route::Evanescent(_)
+    ));
+    for (a, b) in channels(&clear).iter().zip(&channels(&weak)) {
+        for (x, y) in [(a.r, b.r), (a.t, b.t)] {
+            let (x, y) = (x.unwrap(), y.unwrap());
+            assert!(y.iter().all(|v| v.is_finite()));
+            assert!((x - y).abs().max() < 1e-9, "{x} vs {y}");
+        }
+    }
+}

@@ -6,7 +6,8 @@ Mitsuba's own plugins: a title naming the plugin (``(:monosp:`name`)``) and a
 ``(Default: ...)``, and optionally flags such as ``|exposed|``). This script converts the rows
 to Markdown and replaces the regions of plugin/README.md between
 ``<!-- params:<region>:begin ... -->`` and ``<!-- params:<region>:end -->``: ``common`` holds
-the rows identical in every plugin, ``<plugin>`` the others.
+the rows identical in the two surface plugins (``thinbirefringent``, ``birefringent``),
+``<plugin>`` the others (every row of a plugin outside those two, ``birefringentstack``).
 
     python tools/plugin_docs.py            # rewrite plugin/README.md
     python tools/plugin_docs.py --check    # exit 1 (with a diff) if it is out of date
@@ -30,7 +31,9 @@ SUBSTITUTIONS = {"|float|": "float", "|string|": "string", "|texture|": "texture
                  "|vector|": "vector", "|bool|": "boolean", "|int|": "integer",
                  "|spectrum|": "spectrum", "|true|": "`true`", "|false|": "`false`",
                  "|exposed|": "exposed", "|differentiable|": "differentiable",
-                 "|discontinuous|": "discontinuous"}
+                 "|discontinuous|": "discontinuous", "|bsdf|": "BSDF"}
+#: The plugins whose shared rows form the ``common`` region.
+COMMON = ("thinbirefringent", "birefringent")
 DEFAULT = re.compile(r"\s*\(Default: (.*)\)\s*$", re.S)
 TITLE = re.compile(r"\(:monosp:`(\w+)`\)\s*$", re.M)
 
@@ -120,11 +123,11 @@ def plugins() -> dict[str, list[Parameter]]:
 def regions() -> dict[str, str]:
     """The Markdown table of each README region."""
     table = plugins()
-    common = [p for p in next(iter(table.values())) if all(p in ps for ps in table.values())]
+    common = [p for p in table[COMMON[0]] if all(p in table[name] for name in COMMON)]
     header = "| name | type | default | meaning | flags |\n| --- | --- | --- | --- | --- |\n"
     out = {"common": header + "".join(p.markdown() + "\n" for p in common)}
     for name, params in table.items():
-        own = [p for p in params if p not in common]
+        own = [p for p in params if name not in COMMON or p not in common]
         out[name] = header + "".join(p.markdown() + "\n" for p in own)
     return out
 

@@ -37,7 +37,8 @@ constexpr size_t MaxChannels = (size_t) bfr::Bounds::MaxChannels;
 /// chunks run in parallel on Dr.Jit's thread pool.
 constexpr size_t ChunkLanes = 1024;
 
-/// Most Mitsuba inputs a query reads per lane.
+/// Most Mitsuba inputs a plate or crystal query reads per lane (a stack reads more: its
+/// queries set their own bound, the template parameter `Inputs` below).
 constexpr size_t MaxInputs = 16;
 
 /// Throws, in a JIT variant, if the call is being recorded (symbolic loops or calls): the
@@ -92,7 +93,7 @@ struct MaskColumn {
  * (one kernel), their memory pointers taken (a literal is materialised on the way), then one
  * `dr::sync_thread()` so that every queued computation has finished before the host reads
  * (without it, most lanes read stale memory). */
-template <typename Float> class HostInputs {
+template <typename Float, size_t Inputs = MaxInputs> class HostInputs {
 public:
     using Mask = dr::mask_t<Float>;
     static constexpr bool Jit = dr::is_jit_v<Float>;
@@ -153,9 +154,9 @@ public:
 private:
     using FloatD = std::conditional_t<Jit, dr::detached_t<Float>, float>;
     using MaskD = std::conditional_t<Jit, dr::detached_t<Mask>, bool>;
-    std::array<FloatD, MaxInputs> m_f{};
+    std::array<FloatD, Inputs> m_f{};
     std::array<MaskD, 2> m_m{};
-    std::array<FloatColumn, MaxInputs> m_fc{};
+    std::array<FloatColumn, Inputs> m_fc{};
     std::array<MaskColumn, 2> m_mc{};
     size_t m_nf = 0, m_nm = 0, m_width = 0;
 };
@@ -244,8 +245,9 @@ template <typename Float, typename Chunk> std::string for_chunks(size_t n, Chunk
 }
 
 /** Double columns for the lanes of one chunk, and the core's answers for them: fixed-size
- * arrays of `Cap` lanes (1 in the scalar variants: no allocation per query). */
-template <size_t Cap> struct ChunkBuffers {
+ * arrays of `Cap` lanes (1 in the scalar variants: no allocation per query), `Inputs` input
+ * columns. */
+template <size_t Cap, size_t Inputs = MaxInputs> struct ChunkBuffers {
     /// A column of doubles: `size` values (1 = the same for every lane of the chunk).
     struct Column {
         std::array<double, Cap> v;
@@ -254,7 +256,7 @@ template <size_t Cap> struct ChunkBuffers {
     };
 
     /// Input columns (filled by the plugin).
-    std::array<Column, MaxInputs> in;
+    std::array<Column, Inputs> in;
     std::array<rust::Slice<const double>, MaxChannels> wavelengths;
     std::array<uint8_t, Cap> active;
     size_t active_size = 0;
@@ -356,9 +358,9 @@ bfr::Tangents tangent_columns(ChunkBuffers<Cap> &b, rust::Slice<const bfr::Tange
  * runs to its end on its thread without waiting on other tasks, so no two chunks share them).
  * Allocating them per chunk cost a 2.9 MB zero-fill and fresh pages each time: measured 5% of an
  * llvm_ad_spectral render. */
-template <typename Float> struct ChunkStorage {
+template <typename Float, size_t Inputs = MaxInputs> struct ChunkStorage {
     static constexpr size_t Cap = dr::is_jit_v<Float> ? ChunkLanes : 1;
-    using Buffers = ChunkBuffers<Cap>;
+    using Buffers = ChunkBuffers<Cap, Inputs>;
 
     Buffers &operator*() {
         if constexpr (dr::is_jit_v<Float>) {

@@ -68,8 +68,8 @@ public:
      * Mitsuba's si.wi; `straight`: the direction for the frames of a straight-through lobe
      * (eval_null_transmission: -wi), else the sampled wo; `types[k]`: the lobe type of
      * component k. */
-    template <size_t Cap>
-    void write(const ChunkBuffers<Cap> &b, size_t n, size_t j, size_t core_channels,
+    template <size_t Cap, size_t In>
+    void write(const ChunkBuffers<Cap, In> &b, size_t n, size_t j, size_t core_channels,
                const Vec3d &wi, bool radiance, const std::optional<Vec3d> &straight,
                const BSDFFlags *types, size_t i) {
         double pdf = b.pdf[j];
@@ -206,8 +206,8 @@ private:
         double in_x[3], out_x[3];
         Mueller4d r_out, r_in_t;
 
-        template <size_t Cap>
-        Frames(const ChunkBuffers<Cap> &b, size_t src, const Vec3d &wi, const Vec3d &wo,
+        template <size_t Cap, size_t In>
+        Frames(const ChunkBuffers<Cap, In> &b, size_t src, const Vec3d &wi, const Vec3d &wo,
                bool radiance) {
             for (size_t k = 0; k < 3; ++k) {
                 in_x[k] = b.in_x[k][src];
@@ -221,14 +221,14 @@ private:
                                                  mueller::stokes_basis(wi_hat));
         }
 
-        template <size_t Cap> bool fits(const ChunkBuffers<Cap> &b, size_t src) const {
+        template <size_t Cap, size_t In> bool fits(const ChunkBuffers<Cap, In> &b, size_t src) const {
             for (size_t k = 0; k < 3; ++k)
                 if (in_x[k] != b.in_x[k][src] || out_x[k] != b.out_x[k][src])
                     return false;
             return true;
         }
 
-        template <size_t Cap> Mueller4d apply(const ChunkBuffers<Cap> &b, size_t src) const {
+        template <size_t Cap, size_t In> Mueller4d apply(const ChunkBuffers<Cap, In> &b, size_t src) const {
             Mueller4d M;
             for (size_t k = 0; k < 16; ++k)
                 M(k / 4, k % 4) = b.value[k][src];

@@ -133,6 +133,26 @@ inline MaterialParams parse_material(const Properties &props, const char *ClassN
     return m;
 }
 
+/// Appends the material `p` to the core's table `table` and returns its index; throws the
+/// core's message (it names the parameter), prefixed by `what` if not empty (e.g. "layer 2: "),
+/// and logs the material's load-time warning.
+inline uint32_t add_material(bfr::Materials &table, const MaterialParams &p, const std::string &what,
+                             const char *ClassName) {
+    uint32_t index = 0;
+    try {
+        if (p.named)
+            index = table.add_named(p.material, p.kappa_o, p.kappa_e);
+        else
+            index = table.add_constant(p.eta_o, p.eta_e, p.kappa_o, p.kappa_e);
+    } catch (const std::exception &e) {  // rust::Error, or a name that is not UTF-8
+        Throw("%s%s", what, e.what());
+    }
+    std::string warning(table.warning(index));
+    if (!warning.empty())
+        Log(Warn, "%s%s", what, warning);
+    return index;
+}
+
 /// A parameter of another plugin that a Mitsuba user is likely to give this one, and what to
 /// give instead.
 struct Foreign {
@@ -152,17 +172,7 @@ void refuse_foreign(const Properties &props, const Foreign (&table)[N], const ch
 /// parameter).
 inline rust::Box<bfr::Materials> make_material(const MaterialParams &p, const char *ClassName) {
     rust::Box<bfr::Materials> table = bfr::new_materials();
-    try {
-        if (p.named)
-            table->add_named(p.material, p.kappa_o, p.kappa_e);
-        else
-            table->add_constant(p.eta_o, p.eta_e, p.kappa_o, p.kappa_e);
-    } catch (const std::exception &e) {  // rust::Error, or a name that is not UTF-8
-        Throw("%s", e.what());
-    }
-    std::string warning(table->warning(0));
-    if (!warning.empty())
-        Log(Warn, "%s", warning);
+    add_material(*table, p, "", ClassName);
     return table;
 }
 

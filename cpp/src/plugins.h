@@ -76,8 +76,8 @@ struct PathColumns {
 };
 
 /// Queues the inputs of PathColumns on `in`.
-template <typename Float, typename Spectrum, typename Interaction, typename Mask>
-PathColumns add_path_inputs(HostInputs<Float> &in, const Interaction &si, const Float &sample1,
+template <typename Float, typename Spectrum, size_t Inputs, typename Interaction, typename Mask>
+PathColumns add_path_inputs(HostInputs<Float, Inputs> &in, const Interaction &si, const Float &sample1,
                             const Mask &active) {
     PathColumns c;
     c.active = in.add_mask(active);
@@ -94,12 +94,12 @@ PathColumns add_path_inputs(HostInputs<Float> &in, const Interaction &si, const 
     return c;
 }
 
-/// Lanes [begin, end) of PathColumns into `lanes` (a PlateLanes or CrystalLanes): `count`,
+/// Lanes [begin, end) of PathColumns into `lanes` (a PlateLanes, StackLanes or CrystalLanes): `count`,
 /// `active`, `wi` in input columns `wi_x`, `wi_x + 1`, `wi_x + 2`, `sample` in `wi_x + 3`, and
 /// the sampled wavelengths in columns `wave0`, `wave0 + 1`, ... (the caller sets
 /// `wavelengths_nm`).
-template <typename Lanes, size_t Cap, typename Float>
-void fill_path_lanes(Lanes &lanes, ChunkBuffers<Cap> &b, const HostInputs<Float> &in,
+template <typename Lanes, size_t Cap, size_t In, typename Float, size_t Inputs>
+void fill_path_lanes(Lanes &lanes, ChunkBuffers<Cap, In> &b, const HostInputs<Float, Inputs> &in,
                      const PathColumns &c, size_t begin, size_t end, size_t wi_x, size_t wave0) {
     lanes.count = end - begin;
     lanes.active = b.convert_mask(in.masks(c.active), begin, end);
@@ -111,9 +111,10 @@ void fill_path_lanes(Lanes &lanes, ChunkBuffers<Cap> &b, const HostInputs<Float>
         b.convert(wave0 + w, in.floats(c.first_wave + w), begin, end);
 }
 
-/// Defined in thinbirefringent.cpp and birefringent.cpp.
+/// Defined in thinbirefringent.cpp, birefringent.cpp and birefringentstack.cpp.
 void register_thinbirefringent();
 void register_birefringent();
+void register_birefringentstack();
 
 NAMESPACE_END(shim)
 NAMESPACE_END(mitsuba)

@@ -11,6 +11,7 @@ void register_plugins() {
             "Mitsuba's PluginManager is not initialised (import mitsuba first)");
     mitsuba::shim::register_thinbirefringent();
     mitsuba::shim::register_birefringent();
+    mitsuba::shim::register_birefringentstack();
 }
 
 rust::Str supported_variants() { return mitsuba::shim::SupportedVariants; }

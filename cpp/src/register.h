@@ -5,7 +5,7 @@
 
 namespace bfr {
 
-/// Registers `thinbirefringent` and `birefringent` with Mitsuba's PluginManager (again, if
+/// Registers `thinbirefringent`, `birefringent` and `birefringentstack` with Mitsuba's PluginManager (again, if
 /// they were: the new registration replaces the old); throws a message on failure.
 void register_plugins();
 

@@ -152,13 +152,15 @@ evaluated with ``eval_1`` at the hit point (use ``raw="true"`` for data bitmaps)
 #include "plugins.h"
 #include "differentiable.h"
 #include "last_valid.h"
+#include "layer.h"
 #include "scalar_texture.h"
 #include "signed_rgb.h"
 
 NAMESPACE_BEGIN(mitsuba)
 
 template <typename Float, typename Spectrum>
-class ThinBirefringent final : public BSDF<Float, Spectrum> {
+class ThinBirefringent final : public BSDF<Float, Spectrum>,
+                               public shim::LayerSource<Float, Spectrum> {
 public:
     MI_IMPORT_BASE(BSDF, m_flags, m_components)
     MI_IMPORT_TYPES(Texture)
@@ -183,6 +185,9 @@ public:
 
     ThinBirefringent(const Properties &props) : Base(props) {
         shim::refuse_foreign(props, Foreign, ClassName);
+        for (const char *name : { "ext_ior", "exit_ior", "filter_bandwidth", "channel", "absorbing_exit" })
+            if (props.has_property(name))
+                m_surroundings.push_back(name);
         shim::Defaults defaults;
         shim::MaterialParams material = shim::parse_material(props, ClassName, defaults,
                                                              props.has_property("birefringence"));
@@ -214,10 +219,14 @@ public:
     /// eta_o, eta_e, kappa_o, kappa_e, optic_axis and the textures' values are differentiable
     /// in the JIT variants (differentiable.h); the media, scales and band are not.
     void traverse(TraversalCallback *cb) override {
-        m_diff.traverse(cb);
-        const ParamFlags textures = shim::texture_flags<Float>();
-        cb->put("ext_ior", m_ext_ior, ParamFlags::NonDifferentiable);
-        cb->put("exit_ior", m_exit_ior, ParamFlags::NonDifferentiable);
+        // A stack's layer: its gradients do not flow through the stack (not differentiable).
+        m_diff.traverse(cb, !m_nested);
+        const ParamFlags textures =
+            m_nested ? ParamFlags::NonDifferentiable : shim::texture_flags<Float>();
+        if (!m_nested) {
+            cb->put("ext_ior", m_ext_ior, ParamFlags::NonDifferentiable);
+            cb->put("exit_ior", m_exit_ior, ParamFlags::NonDifferentiable);
+        }
         cb->put("thickness", m_thickness, textures);
         cb->put("thickness_scale", m_thickness_scale, ParamFlags::NonDifferentiable);
         if (m_birefringence)
@@ -225,7 +234,8 @@ public:
         cb->put("birefringence_scale", m_birefringence_scale, ParamFlags::NonDifferentiable);
         if (m_axis_angle)
             cb->put("axis_angle", m_axis_angle, textures);
-        cb->put("filter_bandwidth", m_filter_bandwidth, ParamFlags::NonDifferentiable);
+        if (!m_nested)
+            cb->put("filter_bandwidth", m_filter_bandwidth, ParamFlags::NonDifferentiable);
     }
 
     /// Applies changed parameters; a rejected update leaves the last valid state in force
@@ -300,6 +310,22 @@ public:
         if (!m_null || shim::none_active(active))
             return dr::zeros<Spectrum>();
         return query(si, TransportMode::Radiance, 2u, Float(0.5f), active, true).spectrum();
+    }
+
+    void nest() override { m_nested = true; }
+
+    /// The plate as a layer of a stack (birefringentstack).
+    shim::PlateLayer<Float, Spectrum> layer() const override {
+        shim::PlateLayer<Float, Spectrum> l;
+        l.material = &m_diff.material;
+        l.optic_axis = m_diff.axis;
+        l.thickness = m_thickness.get();
+        l.thickness_scale = m_thickness_scale;
+        l.birefringence = m_birefringence.get();
+        l.birefringence_scale = m_birefringence_scale;
+        l.axis_angle = m_axis_angle.get();
+        l.surroundings = &m_surroundings;
+        return l;
     }
 
     std::string to_string() const override {
@@ -508,6 +534,8 @@ private:
     ref<Texture> m_thickness, m_birefringence, m_axis_angle;
     double m_thickness_scale, m_birefringence_scale, m_filter_bandwidth;
     std::string m_channel;  ///< the colour channel of a mono variant's render
+    std::vector<std::string> m_surroundings;  ///< see shim::PlateLayer::surroundings
+    bool m_nested = false;  ///< a stack's layer (shim::LayerSource::nest)
     bool m_null = true, m_absorbing_exit = false;
     BSDFFlags m_types[(size_t) bfr::Bounds::PlateComponents];
     mutable std::atomic<bool> m_warned { false };

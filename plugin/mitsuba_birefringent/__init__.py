@@ -1,7 +1,8 @@
-"""Birefringent BSDFs for Mitsuba 3: ``thinbirefringent`` (a birefringent plate) and
-``birefringent`` (the surface of a bulk uniaxial crystal).
+"""Birefringent BSDFs for Mitsuba 3: ``thinbirefringent`` (a birefringent plate),
+``birefringentstack`` (a stack of such plates as layers) and ``birefringent`` (the surface of a
+bulk uniaxial crystal).
 
-Importing the package registers both plugins with Mitsuba's plugin manager::
+Importing the package registers the plugins with Mitsuba's plugin manager::
 
     import mitsuba as mi
     import mitsuba_birefringent
@@ -41,7 +42,7 @@ except importlib.metadata.PackageNotFoundError:
                       "`pip install .` (or `make setup`) at the repository root") from None
 
 #: The BSDF plugin names this package registers.
-PLUGINS = ("thinbirefringent", "birefringent")
+PLUGINS = ("thinbirefringent", "birefringentstack", "birefringent")
 
 register()
 

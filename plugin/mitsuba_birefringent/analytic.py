@@ -112,10 +112,13 @@ def assemble(images: list[dict[str, np.ndarray]], to_srgb: np.ndarray) -> dict[s
 
 
 def plugin_nodes(node: Any) -> Iterator[dict]:
-    """Every dict of the scene whose type is one of the package's plugins."""
+    """Every dict of the scene whose type is one of the package's plugins (a stack's layers are
+    part of the stack, not plates of their own)."""
     if isinstance(node, dict):
         if node.get("type") in PLUGIN_TYPES:
             yield node
+            if node["type"] == "birefringentstack":
+                return
         for value in node.values():
             yield from plugin_nodes(value)
 
@@ -123,14 +126,15 @@ def plugin_nodes(node: Any) -> Iterator[dict]:
 def warn_where_inexact(scene: dict) -> None:
     """Warns when a path may meet two plates, or meets a bulk crystal (module docstring)."""
     nodes = list(plugin_nodes(scene))
-    plates = sum(1 for n in nodes if n["type"] == "thinbirefringent")
+    plates = sum(1 for n in nodes if n["type"] in ("thinbirefringent", "birefringentstack"))
     if plates > 1:
         warnings.warn(
-            f"the scene has {plates} thinbirefringent plates: where a path passes through two of "
-            "them, the channel render multiplies their channel integrals, which is not the "
-            "integral of their product (two quartz plates stacked between crossed polarisers: "
-            "CIEDE2000 0.16 for 5 + 60 um, 2-3 for 20 + 35 um, 8.3 for 50 + 50 um with parallel "
-            "axes; docs/physics.md, section 7). Plates side by side are exact.",
+            f"the scene has {plates} thinbirefringent plates or stacks: where a path passes "
+            "through two of them, the channel render multiplies their channel integrals, which "
+            "is not the integral of their product (two quartz plates stacked between crossed "
+            "polarisers: CIEDE2000 0.16 for 5 + 60 um, 2-3 for 20 + 35 um, 8.3 for 50 + 50 um "
+            "with parallel axes; docs/physics.md, section 7). Plates side by side are exact, and "
+            "so are plates in contact given as the layers of one birefringentstack.",
             stacklevel=3)
     if any(n["type"] == "birefringent" for n in nodes):
         warnings.warn(

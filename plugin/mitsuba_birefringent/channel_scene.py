@@ -26,8 +26,9 @@ from typing import Any
 import mitsuba as mi
 import numpy as np
 
-#: The plugins of this package (their parameters are physical scalars: never rewritten).
-PLUGIN_TYPES = ("thinbirefringent", "birefringent")
+#: The plugins of this package (their parameters are physical scalars: never rewritten; a
+#: stack's nested plates are its layers, which it integrates over the channel itself).
+PLUGIN_TYPES = ("thinbirefringent", "birefringent", "birefringentstack")
 
 #: Mitsuba 3.9.1's emitter plugins whose spectrum a scene gives (a texture or spectrum).
 EMITTER_TYPES = ("area", "point", "spot", "constant", "envmap", "directional", "directionalarea",

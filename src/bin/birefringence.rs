@@ -12,7 +12,7 @@ use birefringent::calc;
 use std::io::{BufRead, Read, Write};
 
 const USAGE: &str = "usage: birefringence <subcommand> [--batch] [FILE]
-subcommands: interface, slab
+subcommands: interface, slab, stack
 Reads one JSON object (or JSON lines with --batch) from FILE or standard input.
 See docs/calculator.md for the fields.";
 

@@ -84,7 +84,7 @@ fn named_ior(name: &str, s: &str) -> Result<C64> {
 }
 
 /// The material from `eta_o`/`eta_e` or `material`, plus optional `kappa_o`/`kappa_e`.
-fn read_material(f: &mut Fields) -> Result<Material> {
+pub(super) fn read_material(f: &mut Fields) -> Result<Material> {
     let name = f.string("material")?;
     let (eo, ee) = (f.complex("eta_o")?, f.complex("eta_e")?);
     let (ko, ke) = (f.number("kappa_o")?, f.number("kappa_e")?);

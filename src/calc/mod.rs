@@ -6,18 +6,20 @@ pub mod media;
 pub mod output;
 pub mod slab;
 pub mod spectrum;
+pub mod stack;
 
 use crate::error::{Error, Result};
 use serde_json::{json, Value};
 
 /// The subcommands.
-pub const SUBCOMMANDS: [&str; 2] = ["interface", "slab"];
+pub const SUBCOMMANDS: [&str; 3] = ["interface", "slab", "stack"];
 
 /// Runs `subcommand` on one input object; errors become `{"error": "..."}` at the caller.
 pub fn run(subcommand: &str, input: &Value) -> Result<Value> {
     match subcommand {
         "interface" => interface::run(input),
         "slab" => run_slab(input),
+        "stack" => stack::run(input),
         _ => Err(Error::new(
             "subcommand",
             format!(

@@ -75,7 +75,7 @@ pub fn run_monochromatic(input: &Value, fields: &[&str]) -> Result<Value> {
     let optics = q.slab.optics(&q.frame, q.beta)?;
     let j = optics.jones(q.wavelength_nm, Want::BOTH)?;
     let (r, t) = (j.r.unwrap_or_default(), j.t.unwrap_or_default());
-    check_passive(&r, &t)?;
+    check_passive("slab", "plate", &r, &t)?;
     let mut out = Map::new();
     out.insert("R".into(), powers(&r));
     out.insert("T".into(), powers(&t));
@@ -101,22 +101,27 @@ const SP: [&str; 2] = ["s", "p"];
 /// absorbing layer under an exterior of index 595).
 const PASSIVE_SLACK: f64 = 1e-6;
 
-/// A plate is passive (`κ ≥ 0`): for each input polarisation it reflects and transmits at
-/// most the incident power. Where the computation gains energy beyond rounding, the result is
+/// A plate or stack (`what`, errors under `parameter`) is passive (`κ ≥ 0`): for each input
+/// polarisation it reflects and transmits at most the incident power. Where the computation gains energy beyond rounding, the result is
 /// refused rather than returned: the known case is a weakly birefringent plate in which the o
 /// and e waves are both near grazing (an exterior denser than the plate, β close to both
 /// indices), where the modes' basis is ill-conditioned (docs/physics.md, §4, Known
 /// limitations).
-fn check_passive(r: &Matrix2<C64>, t: &Matrix2<C64>) -> Result<()> {
+pub(super) fn check_passive(
+    parameter: &str,
+    what: &str,
+    r: &Matrix2<C64>,
+    t: &Matrix2<C64>,
+) -> Result<()> {
     for (a, input) in SP.iter().enumerate() {
         let total: f64 = (0..2)
             .map(|b| r[(b, a)].norm_sqr() + t[(b, a)].norm_sqr())
             .sum();
         if total > 1.0 + PASSIVE_SLACK {
             return Err(Error::new(
-                "slab",
+                parameter,
                 format!(
-                    "the computed plate reflects and transmits {total:.7} of the incident {input} \
+                    "the computed {what} reflects and transmits {total:.7} of the incident {input} \
                      power (more than it receives): its o and e waves are near grazing and nearly \
                      degenerate at this incidence, where the method is ill-conditioned; change \
                      the incidence or the indices slightly"
@@ -139,7 +144,7 @@ pub fn powers(j: &Matrix2<C64>) -> Value {
 }
 
 /// Rows = output (s, p), columns = input (s, p), entries `[re, im]`.
-fn jones(j: &Matrix2<C64>) -> Value {
+pub(super) fn jones(j: &Matrix2<C64>) -> Value {
     json!((0..2)
         .map(|r| (0..2).map(|c| complex(j[(r, c)])).collect::<Vec<_>>())
         .collect::<Vec<_>>())

@@ -7,7 +7,7 @@
 use super::input::Fields;
 use super::output::num;
 use super::slab::{matrix, read, SlabQuery};
-use crate::band::{is_exact_band, narrow_band};
+use crate::band::{is_exact_band, narrow_band, Gaussian};
 use crate::error::{Error, Result};
 use crate::params::Bandwidth;
 use crate::plate::slab::Output;
@@ -19,12 +19,37 @@ use nalgebra::{Matrix4, Vector4};
 use serde_json::{json, Map, Value};
 
 /// Visible range of the tabulated weights (nm).
-const RANGE: (f64, f64) = crate::material::RENDER_RANGE_NM;
+pub const RANGE: (f64, f64) = crate::material::RENDER_RANGE_NM;
 
-/// Runs `slab` with the `spectrum` object `spec`.
-pub fn run(input: &Value, fields: &[&str], spec: &Value) -> Result<Value> {
-    let mut f = Fields::new(input, fields)?;
-    let q = read(&mut f)?;
+/// What a `spectrum` object asks for.
+pub enum Over {
+    /// The three channels of a weight set.
+    Weights(WeightSet),
+    /// A Gaussian band of this FWHM (nm) around the query's wavelength.
+    Band(f64),
+}
+
+/// A parsed `spectrum` object.
+pub struct Request<'a> {
+    /// Channels or a band.
+    pub over: Over,
+    /// `"analytic"`, `"exact"` or `"quadrature"`.
+    pub method: &'a str,
+    /// The accuracy of the closed form (`"analytic"`: perceptual).
+    pub accuracy: Accuracy,
+    /// The quadrature's step (nm), if given.
+    pub step: Option<f64>,
+}
+
+impl Request<'_> {
+    /// True for the dense quadrature of the exact result (the reference).
+    pub fn quadrature(&self) -> bool {
+        self.method == "quadrature"
+    }
+}
+
+/// Reads the `spectrum` object `spec` of a query at `wavelength_nm`.
+pub fn read_request(spec: &Value, wavelength_nm: f64) -> Result<Request<'_>> {
     let mut s = Fields::nested(
         spec,
         &["weights", "method", "step_nm", "bandwidth_nm"],
@@ -50,64 +75,89 @@ pub fn run(input: &Value, fields: &[&str], spec: &Value) -> Result<Value> {
             ));
         }
     }
-    let quad = method == "quadrature";
+    let over = match (s.string("weights")?, s.number("bandwidth_nm")?) {
+        (Some(w), None) => Over::Weights(WeightSet::parse(w).ok_or_else(|| {
+            Error::new(
+                "spectrum.weights",
+                format!("must be \"srgb-d65\", \"xyz-d65\" or \"xyz-e\", got \"{w}\""),
+            )
+        })?),
+        (None, Some(b)) => {
+            Over::Band(Bandwidth::new("spectrum.bandwidth_nm", b, wavelength_nm)?.fwhm_nm())
+        }
+        (Some(_), Some(_)) => {
+            return Err(Error::new(
+                "spectrum",
+                "give weights or bandwidth_nm, not both",
+            ))
+        }
+        (None, None) => return Err(Error::new("spectrum", "give weights or bandwidth_nm")),
+    };
+    Ok(Request {
+        over,
+        method,
+        accuracy,
+        step,
+    })
+}
+
+/// The channel names of a request at `wavelength_nm`.
+pub fn channel_names(over: &Over, wavelength_nm: f64) -> Vec<String> {
+    match over {
+        Over::Weights(set) => set.channel_names().iter().map(|s| s.to_string()).collect(),
+        Over::Band(b) => vec![format!("{wavelength_nm} nm ± {b} nm FWHM")],
+    }
+}
+
+/// Runs `slab` with the `spectrum` object `spec`.
+pub fn run(input: &Value, fields: &[&str], spec: &Value) -> Result<Value> {
+    let mut f = Fields::new(input, fields)?;
+    let q = read(&mut f)?;
+    let request = read_request(spec, q.wavelength_nm)?;
     let mut warnings = q.warnings.clone();
-    let (names, results): (Vec<String>, Vec<SlabMueller>) =
-        match (s.string("weights")?, s.number("bandwidth_nm")?) {
-            (Some(w), None) => {
-                let set = WeightSet::parse(w).ok_or_else(|| {
-                    Error::new(
-                        "spectrum.weights",
-                        format!("must be \"srgb-d65\", \"xyz-d65\" or \"xyz-e\", got \"{w}\""),
-                    )
-                })?;
-                warnings.extend(q.plate.material.coverage(RANGE.0, RANGE.1)?);
-                let step = step.unwrap_or_else(|| auto_step(&q, RANGE.0));
-                let per_channel = if quad {
-                    (0..3)
-                        .map(|c| {
-                            quadrature(
-                                &q.plate,
-                                &q.frame,
-                                q.beta,
-                                |l| weight_per_nm(set, c, l),
-                                RANGE,
-                                step,
-                                Want::BOTH,
-                            )
-                            .map_err(step_field)
-                        })
-                        .collect::<Result<Vec<_>>>()?
-                } else {
-                    PlateModel::new(&q.plate, q.frame, q.beta)
-                        .channels(set, Want::BOTH, Output::Mueller, accuracy)?
-                        .to_vec()
-                };
-                (
-                    set.channel_names().iter().map(|s| s.to_string()).collect(),
-                    per_channel,
-                )
+    let results: Vec<SlabMueller> = match request.over {
+        Over::Weights(set) => {
+            warnings.extend(q.plate.material.coverage(RANGE.0, RANGE.1)?);
+            if request.quadrature() {
+                let step = request.step.unwrap_or_else(|| auto_step(&q, RANGE.0));
+                (0..3)
+                    .map(|c| {
+                        quadrature(
+                            &q.plate,
+                            &q.frame,
+                            q.beta,
+                            |l| weight_per_nm(set, c, l),
+                            RANGE,
+                            step,
+                            Want::BOTH,
+                        )
+                        .map_err(step_field)
+                    })
+                    .collect::<Result<Vec<_>>>()?
+            } else {
+                PlateModel::new(&q.plate, q.frame, q.beta)
+                    .channels(set, Want::BOTH, Output::Mueller, request.accuracy)?
+                    .to_vec()
             }
-            (None, Some(b)) => {
-                let m = band(
-                    &q,
-                    Bandwidth::new("spectrum.bandwidth_nm", b, q.wavelength_nm)?,
-                    quad,
-                    step,
-                )?;
-                (
-                    vec![format!("{} nm ± {b} nm FWHM", q.wavelength_nm)],
-                    vec![m],
-                )
-            }
-            (Some(_), Some(_)) => {
-                return Err(Error::new(
-                    "spectrum",
-                    "give weights or bandwidth_nm, not both",
-                ))
-            }
-            (None, None) => return Err(Error::new("spectrum", "give weights or bandwidth_nm")),
-        };
+        }
+        Over::Band(b) => vec![band(&q, b, request.quadrature(), request.step)?],
+    };
+    Ok(encode(
+        channel_names(&request.over, q.wavelength_nm),
+        &results,
+        request.method,
+        &warnings,
+    ))
+}
+
+/// The output of a spectrum query: power terms and Mueller matrices per channel (a list when
+/// there are several channels), the channel names, the method and the warnings.
+pub fn encode(
+    names: Vec<String>,
+    results: &[SlabMueller],
+    method: &str,
+    warnings: &[String],
+) -> Value {
     let list = names.len() > 1;
     let pick = |v: Vec<Value>| {
         if list {
@@ -142,8 +192,8 @@ pub fn run(input: &Value, fields: &[&str], spec: &Value) -> Result<Value> {
     }
     out.insert("channels".into(), json!(names));
     out.insert("method".into(), json!(method));
-    super::output::insert_warnings(&mut out, &warnings);
-    Ok(Value::Object(out))
+    super::output::insert_warnings(&mut out, warnings);
+    Value::Object(out)
 }
 
 /// Power from linear input `s` (`input = 1`) or `p` (`−1`) into output `s` (`1`) or `p` (`−1`)
@@ -153,9 +203,8 @@ fn power(m: &Matrix4<f64>, input: f64, output: f64) -> f64 {
     0.5 * (out[0] + output * out[1])
 }
 
-/// A Gaussian band of FWHM `b` around the query's wavelength.
-fn band(q: &SlabQuery, b: Bandwidth, quad: bool, step: Option<f64>) -> Result<SlabMueller> {
-    let b = b.fwhm_nm();
+/// A Gaussian band of FWHM `b` (validated) around the query's wavelength.
+fn band(q: &SlabQuery, b: f64, quad: bool, step: Option<f64>) -> Result<SlabMueller> {
     if is_exact_band(b, q.wavelength_nm) {
         return q
             .slab
@@ -171,18 +220,12 @@ fn band(q: &SlabQuery, b: Bandwidth, quad: bool, step: Option<f64>) -> Result<Sl
             &mut None,
         );
     }
-    let weight = move |lambda: f64| {
-        let k = std::f64::consts::TAU / lambda;
-        let z = (k - g.mu) / g.sigma;
-        (-0.5 * z * z).exp() / (g.sigma * std::f64::consts::TAU.sqrt()) * std::f64::consts::TAU
-            / (lambda * lambda)
-    };
-    let range = (q.wavelength_nm - 4.0 * b, q.wavelength_nm + 4.0 * b);
+    let range = band_range(q.wavelength_nm, b);
     quadrature(
         &q.plate,
         &q.frame,
         q.beta,
-        weight,
+        band_weight(g),
         range,
         step.unwrap_or_else(|| auto_step(q, range.0)),
         Want::BOTH,
@@ -190,8 +233,23 @@ fn band(q: &SlabQuery, b: Bandwidth, quad: bool, step: Option<f64>) -> Result<Sl
     .map_err(step_field)
 }
 
+/// The weight per nm of the Gaussian band `g` (unit mass in wavenumber).
+pub fn band_weight(g: Gaussian) -> impl Fn(f64) -> f64 {
+    move |lambda: f64| {
+        let k = std::f64::consts::TAU / lambda;
+        let z = (k - g.mu) / g.sigma;
+        (-0.5 * z * z).exp() / (g.sigma * std::f64::consts::TAU.sqrt()) * std::f64::consts::TAU
+            / (lambda * lambda)
+    }
+}
+
+/// The wavelengths a band's quadrature covers: ±4 FWHM around its centre.
+pub fn band_range(wavelength_nm: f64, fwhm_nm: f64) -> (f64, f64) {
+    (wavelength_nm - 4.0 * fwhm_nm, wavelength_nm + 4.0 * fwhm_nm)
+}
+
 /// The quadrature's error about its step under the name of the field that sets it.
-fn step_field(e: Error) -> Error {
+pub fn step_field(e: Error) -> Error {
     if e.parameter == "step_nm" {
         Error::new("spectrum.step_nm", e.message)
     } else {

@@ -32,7 +32,7 @@ const _: () = assert!(Bounds::PlateComponents.repr as usize == PLATE_SLOTS);
 
 /// One lane's lobes per channel: filled in place by a lane (a crystal's are 8 KB, which moving
 /// by value cost more than computing an isotropic crystal's lobes).
-type Lobes<const S: usize> = [Slots<S>; MAX_CHANNELS];
+pub(super) type Lobes<const S: usize> = [Slots<S>; MAX_CHANNELS];
 
 /// Samples a plate lobe in every lane (see `bridge::sample_plate`).
 pub fn sample_plate(
@@ -170,7 +170,7 @@ fn crystal_batch(
 }
 
 /// The call's status; a call that failed as a whole leaves its message.
-fn finish(r: Result<Status>, out: &mut Samples) -> Status {
+pub(super) fn finish(r: Result<Status>, out: &mut Samples) -> Status {
     r.unwrap_or_else(|e| {
         out.message = e.to_string();
         status(&e)
@@ -180,7 +180,7 @@ fn finish(r: Result<Status>, out: &mut Samples) -> Status {
 /// Computes each of the call's `count` lanes (`lane(i, lobes)`, skipping inactive ones) and
 /// writes it, with its derivatives (`derive`) if `tangents` asks for them. A lane fills the
 /// channels' slots of `lobes` (one buffer for the call) and returns the chosen slot, if any.
-fn write_lanes<const S: usize>(
+pub(super) fn write_lanes<const S: usize>(
     output: &mut Output,
     mut tangents: Option<&mut TangentOutput>,
     count: usize,
@@ -296,25 +296,34 @@ impl<'a> CommonColumns<'a> {
 
     /// Lane `i`'s transport mode and lobe-choosing number.
     fn transport_and_sample(&self, i: usize) -> Result<(Transport, f64)> {
-        let transport = match self.transport.at(i) {
-            BridgeTransport::Radiance => Transport::Radiance,
-            BridgeTransport::Importance => Transport::Importance,
-            t => {
-                return Err(Error::new(
-                    "transport",
-                    format!("must be Radiance (0) or Importance (1), got {}", t.repr),
-                ))
-            }
-        };
-        let u = self.sample.at(i);
-        if !(0.0..=1.0).contains(&u) {
-            return Err(Error::new(
-                "sample",
-                format!("must be within [0, 1], got {u}"),
-            ));
-        }
-        Ok((transport, u))
+        transport_and_sample(&self.transport, &self.sample, i)
     }
+}
+
+/// Lane `i`'s transport mode and lobe-choosing number, checked.
+pub(super) fn transport_and_sample(
+    transport: &Column<BridgeTransport>,
+    sample: &Column<f64>,
+    i: usize,
+) -> Result<(Transport, f64)> {
+    let transport = match transport.at(i) {
+        BridgeTransport::Radiance => Transport::Radiance,
+        BridgeTransport::Importance => Transport::Importance,
+        t => {
+            return Err(Error::new(
+                "transport",
+                format!("must be Radiance (0) or Importance (1), got {}", t.repr),
+            ))
+        }
+    };
+    let u = sample.at(i);
+    if !(0.0..=1.0).contains(&u) {
+        return Err(Error::new(
+            "sample",
+            format!("must be within [0, 1], got {u}"),
+        ));
+    }
+    Ok((transport, u))
 }
 
 struct PlateColumns<'a> {
@@ -372,7 +381,7 @@ impl<'a> CrystalColumns<'a> {
 
 /// `axis` rotated about the local normal (z) by `degrees`, counter-clockwise seen from +z (from
 /// the tangent s towards t): the plugin's `axis_angle`, which must be finite.
-fn rotated_about_normal(axis: Vector3<f64>, degrees: f64) -> Result<Vector3<f64>> {
+pub(super) fn rotated_about_normal(axis: Vector3<f64>, degrees: f64) -> Result<Vector3<f64>> {
     if !degrees.is_finite() {
         return Err(Error::new(
             "axis_angle",
@@ -391,7 +400,7 @@ fn rotated_about_normal(axis: Vector3<f64>, degrees: f64) -> Result<Vector3<f64>
 }
 
 /// True if component `k` is enabled in the bit set `components`.
-fn enabled(components: u32, k: usize) -> bool {
+pub(super) fn enabled(components: u32, k: usize) -> bool {
     k < 32 && components & (1 << k) != 0
 }
 
@@ -448,18 +457,31 @@ fn plate_lane(
     let point = plate_point(materials, cols, i)?;
     let (s, pick) = spectrum.lane(c.wavelengths.at(i), c.wavelengths.count());
     let per_channel = plate_at(call, cols, i, &point, &s, transport)?;
+    Ok(choose_thin(&per_channel, pick, call, u, lobes))
+}
+
+/// The lobe of a thin element (a plate or a stack) over the channels of its query, and the
+/// channels the query keeps (`pick`: one of them, for a mono variant's channel) written to
+/// `lobes`.
+pub(super) fn choose_thin(
+    per_channel: &[Slots<PLATE_SLOTS>],
+    pick: Option<usize>,
+    call: &PlateCall,
+    u: f64,
+    lobes: &mut Lobes<PLATE_SLOTS>,
+) -> Option<Choice> {
     // The lobe is chosen over every channel of the set, also when the query keeps one: the
     // passes of a channel render then choose alike, and their remaining noise (which lobe a
     // path follows) scales the channels together (no colour noise).
     let choice = choose(
-        &per_channel,
+        per_channel,
         |slot| enabled(call.components, plate_component(slot)),
         u,
     );
     match pick {
         Some(k) => lobes[0] = per_channel[k],
         None => {
-            for (l, p) in lobes.iter_mut().zip(&per_channel) {
+            for (l, p) in lobes.iter_mut().zip(per_channel) {
                 *l = *p;
             }
         }
@@ -468,7 +490,7 @@ fn plate_lane(
         hero: if pick.is_some() { 0 } else { choice.hero },
         ..choice
     };
-    Ok(choice.map(kept))
+    choice.map(kept)
 }
 
 /// The derivatives with respect to `inputs` of lane `i` of a plate batch, which sampled

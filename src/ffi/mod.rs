@@ -5,9 +5,9 @@
 //! what weight. Queries come in batches of lanes (structure of arrays, doubles; a column holds
 //! one value per lane or one value for all), which is what Mitsuba's JIT variants hand a BSDF
 //! (the lanes that hit one instance); the scalar variants send batches of one lane. Each lane
-//! is computed exactly as the scalar query (`render::plate::plate_lobes` or
-//! `render::crystal::crystal_slots`, then `render::choice::choose`), bit for bit, whatever the
-//! other lanes of the batch hold.
+//! is computed exactly as the scalar query (`render::plate::plate_lobes`,
+//! `render::stack::stack_lobes` or `render::crystal::crystal_slots`, then
+//! `render::choice::choose`), bit for bit, whatever the other lanes of the batch hold.
 //!
 //! Rules: every function catches panics (a panic crossing the bridge would abort); invalid
 //! input is reported as [`bridge::Status::Invalid`] with a message naming the parameter, a
@@ -19,6 +19,7 @@ mod guard;
 mod materials;
 mod samples;
 mod spectrum;
+mod stack;
 mod tangents;
 
 pub use batch::{sample_crystal, sample_crystal_tangents, sample_plate, sample_plate_tangents};
@@ -27,6 +28,7 @@ pub use spectrum::{
     band_spectrum, channels_to_linear_srgb, colour_channel_spectrum, colour_channel_wavelength,
     default_channel, exact_spectrum, srgb_spectrum, PlateSpectrum,
 };
+pub use stack::sample_stack;
 pub use tangents::{crystal_tangents_available, plate_tangents_available};
 
 /// The library's version.
@@ -115,6 +117,40 @@ pub mod bridge {
         thickness_nm: &'a [f64],
         /// Added to the extraordinary index (photoelastic stress); 0 for none.
         birefringence: &'a [f64],
+    }
+
+    /// The lanes of a stack query: the per-lane columns of `PlateLanes`, and per layer (in
+    /// order from the exterior down) its material, optic axis and one column each of axis
+    /// angles, thicknesses and added birefringences (`count` values, or one for every lane).
+    #[derive(Debug)]
+    struct StackLanes<'a> {
+        /// Number of lanes.
+        count: usize,
+        /// 0 for a lane to skip (its outputs are zero), else 1.
+        active: &'a [u8],
+        /// The lane's transport mode.
+        transport: &'a [Transport],
+        /// A uniform number in [0, 1) that chooses the lobe.
+        sample: &'a [f64],
+        /// Mitsuba's `si.wi` (unit, local).
+        wi: [&'a [f64]; 3],
+        /// Wavelengths (nm), one column per channel, for exact and band spectra; none for a
+        /// channel set.
+        wavelengths_nm: &'a [&'a [f64]],
+        /// Real index of the exterior (z > 0).
+        ext_ior: &'a [f64],
+        /// Real index of the exit medium (below the stack).
+        exit_ior: &'a [f64],
+        /// Per layer: the index of its material in the `Materials` table.
+        material: &'a [u32],
+        /// Per layer: its optic axis (local, any non-zero length), before its axis angle.
+        optic_axis: [&'a [f64]; 3],
+        /// Per layer, a column: degrees by which its optic axis is rotated about the normal.
+        axis_angle_deg: &'a [&'a [f64]],
+        /// Per layer, a column: its thickness (nm), within [0, 1 m].
+        thickness_nm: &'a [&'a [f64]],
+        /// Per layer, a column: added to its extraordinary index; 0 for none.
+        birefringence: &'a [&'a [f64]],
     }
 
     /// The lanes of a bulk crystal query (crystal below the surface, z < 0); columns as in
@@ -287,6 +323,16 @@ pub mod bridge {
             spectrum: &PlateSpectrum,
             call: &PlateCall,
             lanes: &PlateLanes,
+            out: &mut Samples,
+        ) -> Status;
+
+        /// Samples a stack lobe (slot 0 reflection, 1 transmission) in every lane; returns as
+        /// `sample_plate`.
+        fn sample_stack(
+            materials: &Materials,
+            spectrum: &PlateSpectrum,
+            call: &PlateCall,
+            lanes: &StackLanes,
             out: &mut Samples,
         ) -> Status;
 

@@ -231,7 +231,11 @@ fn propagation(thickness_nm: f64, lambda_nm: f64, q: &[C64; 4]) -> (Matrix2<C64>
 /// The diagonals of [`propagation`]. The o-wave's `q↑ = −q↓` (bit for bit, as
 /// [`crate::optics::modes`] builds them) shares one exponential.
 #[inline]
-fn phase_factors(thickness_nm: f64, lambda_nm: f64, q: &[C64; 4]) -> ([C64; 2], [C64; 2]) {
+pub(crate) fn phase_factors(
+    thickness_nm: f64,
+    lambda_nm: f64,
+    q: &[C64; 4],
+) -> ([C64; 2], [C64; 2]) {
     let kd = std::f64::consts::TAU * thickness_nm / lambda_nm;
     let i = C64::new(0.0, 1.0);
     let p = |k: usize, sign: f64| expi(i * q[k] * (sign * kd));
@@ -243,7 +247,7 @@ fn phase_factors(thickness_nm: f64, lambda_nm: f64, q: &[C64; 4]) -> ([C64; 2], 
 /// `m⁻¹` by the adjugate with one division; `None` if the determinant is exactly zero (the
 /// criterion of `nalgebra`'s `try_inverse`, which this replaces on the hot path).
 #[inline]
-fn inverse(m: &Matrix2<C64>) -> Option<Matrix2<C64>> {
+pub(crate) fn inverse(m: &Matrix2<C64>) -> Option<Matrix2<C64>> {
     let det = m[(0, 0)] * m[(1, 1)] - m[(0, 1)] * m[(1, 0)];
     if det == C64::new(0.0, 0.0) {
         return None;
@@ -281,7 +285,7 @@ fn scale_rows(a: &[C64; 2], m: &Matrix2<C64>) -> Matrix2<C64> {
 
 /// `diag(a) m diag(b)`.
 #[inline]
-fn scale(a: &[C64; 2], m: &Matrix2<C64>, b: &[C64; 2]) -> Matrix2<C64> {
+pub(crate) fn scale(a: &[C64; 2], m: &Matrix2<C64>, b: &[C64; 2]) -> Matrix2<C64> {
     Matrix2::new(
         a[0] * m[(0, 0)] * b[0],
         a[0] * m[(0, 1)] * b[1],

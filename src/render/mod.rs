@@ -15,7 +15,9 @@ pub mod isotropic;
 pub mod mitsuba_frames;
 pub mod plate;
 pub mod slots;
+pub mod stack;
 pub mod tangents;
+pub mod thin;
 
 use nalgebra::{Matrix4, Vector3};
 

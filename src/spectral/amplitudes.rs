@@ -258,11 +258,11 @@ pub fn least_attenuation(plate: &Plate, amplitudes: &Amplitudes) -> Option<[f64;
     };
     // Lobatto order: finest node 0 is t = 1 (the short-wave end), the last t = −1.
     let points = [(k0, centre), (k0 + a, ends[0]), (k0 - a, ends[1])];
-    // A wave is evanescent where it decays faster than it oscillates (`Im q > |Re q|`): a clear
-    // layer's propagating waves have `Im q = 0`, and a barely absorbing layer's (kappa 1e-272)
-    // a tiny `Im q`, so a wave turning evanescent inside the band is seen in both (comparing
-    // `Im q` with 0 missed it in the absorbing layer, whose round trip then diverged).
-    let evanescent = |q: &[C64; 4]| q.map(|x| x.im > x.re.abs());
+    // A clear layer's wave turns evanescent where `q` leaves the real axis (a tilted axis's
+    // evanescent e-wave keeps a real part); a weakly absorbing layer's (every `q` complex) where
+    // its decay overtakes its oscillation, `|Im q| > |Re q|` (with a kappa of 1e-20 the first
+    // test alone saw no change, and the methods that need smooth amplitudes returned NaN).
+    let evanescent = |q: &[C64; 4]| q.map(|x| (x.im != 0.0, x.im.abs() > x.re.abs()));
     if points
         .iter()
         .any(|(_, q)| evanescent(q) != evanescent(&centre))

@@ -12,6 +12,9 @@
 //! only ~3x per degree near its UV absorption) are tried again with [`MORE_NODES`]. Otherwise (a
 //! critical angle or a degenerate mode inside the band, where the blocks are not smooth) the
 //! caller solves every node exactly.
+//!
+//! [`Interpolant`] is the same series for any vector of values (a stack's `N + 1` interfaces,
+//! [`crate::stack::spectral`]), with the caller's tolerance.
 
 use crate::error::Result;
 use crate::plate::slab::{SlabBlocks, BLOCK_VALUES};
@@ -21,45 +24,54 @@ use num_complex::Complex64 as C64;
 pub const NODES: usize = 16;
 /// Chebyshev nodes of the second attempt.
 pub const MORE_NODES: usize = 32;
-/// Largest accepted interpolation error at the check points, relative to the largest value.
+/// Largest accepted interpolation error of a plate's blocks at the check points, relative to
+/// the largest value.
 pub const TOLERANCE: f64 = 1e-10;
+/// Trailing coefficients of a plate's blocks are dropped while their sum stays below this,
+/// relative to the largest value.
+const TRUNCATION: f64 = 0.1 * TOLERANCE;
 /// Where the interpolant is checked, in `[−1, 1]` (between nodes, ends included).
 const CHECKS: [f64; 4] = [-0.999, -0.61, 0.17, 0.93];
 
-/// Chebyshev coefficients of every value of the blocks on `[lo, hi]` (wavenumbers).
-pub struct BlockInterpolant {
-    coefficients: Vec<[C64; BLOCK_VALUES]>,
+/// Chebyshev coefficients of a vector of complex values on `[lo, hi]` (wavenumbers).
+pub struct Interpolant {
+    /// The coefficient of `T_n` of value `i` at `n · width + i`.
+    coefficients: Vec<C64>,
+    width: usize,
     lo: f64,
     hi: f64,
-    thickness_nm: f64,
 }
 
 /// The series without its trailing coefficients as long as their magnitudes sum to at most
 /// `budget` (`|T_n| ≤ 1` on the interval: that sum bounds the change of every value).
-fn truncated(mut c: Vec<[C64; BLOCK_VALUES]>, budget: f64) -> Vec<[C64; BLOCK_VALUES]> {
+fn truncated(mut c: Vec<C64>, width: usize, budget: f64) -> Vec<C64> {
     let mut dropped = 0.0;
-    while c.len() > 1 {
-        let last = c[c.len() - 1].iter().map(|z| z.norm()).fold(0.0, f64::max);
+    while c.len() > width {
+        let last = c[c.len() - width..]
+            .iter()
+            .map(|z| z.norm())
+            .fold(0.0, f64::max);
         if dropped + last > budget {
             break;
         }
         dropped += last;
-        c.pop();
+        c.truncate(c.len() - width);
     }
     c
 }
 
-impl BlockInterpolant {
-    /// Interpolates `exact(k)` on `[lo, hi]` with [`NODES`], else [`MORE_NODES`] nodes;
-    /// `Ok(None)` if both checks fail.
+impl Interpolant {
+    /// Interpolates `exact(k)` on `[lo, hi]` with [`NODES`], else [`MORE_NODES`] nodes, its
+    /// trailing coefficients dropped while their sum stays below `truncation` of the largest
+    /// value; `Ok(None)` if both miss the exact values at the check points by more than
+    /// `tolerance` of the largest value.
     pub fn new(
-        lo: f64,
-        hi: f64,
-        thickness_nm: f64,
-        exact: &dyn Fn(f64) -> Result<SlabBlocks>,
+        (lo, hi): (f64, f64),
+        (tolerance, truncation): (f64, f64),
+        exact: &dyn Fn(f64) -> Result<Vec<C64>>,
     ) -> Result<Option<Self>> {
         for nodes in [NODES, MORE_NODES] {
-            if let Some(f) = Self::with_nodes(nodes, lo, hi, thickness_nm, exact)? {
+            if let Some(f) = Self::with_nodes(nodes, (lo, hi), (tolerance, truncation), exact)? {
                 return Ok(Some(f));
             }
         }
@@ -69,70 +81,105 @@ impl BlockInterpolant {
     /// The interpolant with `nodes` Chebyshev nodes, if it passes its check.
     fn with_nodes(
         nodes: usize,
-        lo: f64,
-        hi: f64,
-        thickness_nm: f64,
-        exact: &dyn Fn(f64) -> Result<SlabBlocks>,
+        (lo, hi): (f64, f64),
+        (tolerance, truncation): (f64, f64),
+        exact: &dyn Fn(f64) -> Result<Vec<C64>>,
     ) -> Result<Option<Self>> {
         let k_of = |t: f64| 0.5 * (lo + hi) + 0.5 * (hi - lo) * t;
         let angle = |j: usize| std::f64::consts::PI * (j as f64 + 0.5) / nodes as f64;
-        let samples: Vec<[C64; BLOCK_VALUES]> = (0..nodes)
-            .map(|j| exact(k_of(angle(j).cos())).map(|b| b.values()))
+        let samples: Vec<Vec<C64>> = (0..nodes)
+            .map(|j| exact(k_of(angle(j).cos())))
             .collect::<Result<_>>()?;
-        let coefficients = (0..nodes)
-            .map(|n| {
-                let scale = if n == 0 { 1.0 } else { 2.0 } / nodes as f64;
-                let mut c = [C64::new(0.0, 0.0); BLOCK_VALUES];
-                for (j, s) in samples.iter().enumerate() {
-                    let w = scale * (n as f64 * angle(j)).cos();
-                    for (ci, si) in c.iter_mut().zip(s) {
-                        *ci += si * w;
-                    }
+        let width = samples[0].len();
+        let mut coefficients = vec![C64::new(0.0, 0.0); nodes * width];
+        for (n, c) in coefficients.chunks_exact_mut(width).enumerate() {
+            let scale = if n == 0 { 1.0 } else { 2.0 } / nodes as f64;
+            for (j, s) in samples.iter().enumerate() {
+                let w = scale * (n as f64 * angle(j)).cos();
+                for (ci, si) in c.iter_mut().zip(s) {
+                    *ci += si * w;
                 }
-                c
-            })
-            .collect();
+            }
+        }
         let largest = samples
             .iter()
-            .flat_map(|s| s.iter().map(|z| z.norm()))
+            .flatten()
+            .map(|z| z.norm())
             .fold(0.0, f64::max);
-        let f = BlockInterpolant {
-            coefficients: truncated(coefficients, 0.1 * TOLERANCE * largest),
+        let f = Interpolant {
+            coefficients: truncated(coefficients, width, truncation * largest),
+            width,
             lo,
             hi,
-            thickness_nm,
         };
         for t in CHECKS {
-            let (want, got) = (exact(k_of(t))?.values(), f.values(k_of(t)));
+            let (want, got) = (exact(k_of(t))?, f.at(k_of(t)));
             let err = want
                 .iter()
                 .zip(&got)
                 .map(|(a, b)| (a - b).norm())
                 .fold(0.0, f64::max);
-            if err.is_nan() || err > TOLERANCE * largest {
+            if err.is_nan() || err > tolerance * largest {
                 return Ok(None);
             }
         }
         Ok(Some(f))
     }
 
-    /// The interpolated blocks at wavenumber `k` (inside `[lo, hi]`).
-    pub fn at(&self, k: f64) -> SlabBlocks {
-        SlabBlocks::from_values(&self.values(k), self.thickness_nm)
+    /// The interpolated values at wavenumber `k` (inside `[lo, hi]`).
+    pub fn at(&self, k: f64) -> Vec<C64> {
+        let mut out = vec![C64::new(0.0, 0.0); self.width];
+        self.at_into(k, &mut out);
+        out
     }
 
-    /// `Σ_n c_n T_n(t)` for every value at once, `T_n` by their three-term recurrence (stable
-    /// on `[−1, 1]`, where `|T_n| ≤ 1`); one multiply-add per value and degree.
-    fn values(&self, k: f64) -> [C64; BLOCK_VALUES] {
+    /// [`Interpolant::at`] into `out`: `Σ_n c_n T_n(t)` for every value at once, `T_n` by
+    /// their three-term recurrence (stable on `[−1, 1]`, where `|T_n| ≤ 1`); one multiply-add
+    /// per value and degree.
+    pub fn at_into(&self, k: f64, out: &mut [C64]) {
         let t = (2.0 * k - self.lo - self.hi) / (self.hi - self.lo);
-        let mut out = self.coefficients[0];
+        let mut degrees = self.coefficients.chunks_exact(self.width);
+        out.copy_from_slice(degrees.next().expect("at least one coefficient"));
         let (mut previous, mut current) = (1.0, t);
-        for c in &self.coefficients[1..] {
+        for c in degrees {
             for (o, ci) in out.iter_mut().zip(c) {
                 *o += ci * current;
             }
             (previous, current) = (current, 2.0 * t * current - previous);
         }
-        out
+    }
+}
+
+/// A plate's blocks ([`SlabBlocks::values`]) interpolated by an [`Interpolant`].
+pub struct BlockInterpolant {
+    values: Interpolant,
+    thickness_nm: f64,
+}
+
+impl BlockInterpolant {
+    /// Interpolates `exact(k)` on `[lo, hi]` to [`TOLERANCE`] ([`Interpolant::new`]);
+    /// `Ok(None)` if it cannot.
+    pub fn new(
+        lo: f64,
+        hi: f64,
+        thickness_nm: f64,
+        exact: &dyn Fn(f64) -> Result<SlabBlocks>,
+    ) -> Result<Option<Self>> {
+        let values = |k: f64| exact(k).map(|b| b.values().to_vec());
+        Ok(
+            Interpolant::new((lo, hi), (TOLERANCE, TRUNCATION), &values)?.map(|values| {
+                BlockInterpolant {
+                    values,
+                    thickness_nm,
+                }
+            }),
+        )
+    }
+
+    /// The interpolated blocks at wavenumber `k` (inside `[lo, hi]`).
+    pub fn at(&self, k: f64) -> SlabBlocks {
+        let mut v = [C64::new(0.0, 0.0); BLOCK_VALUES];
+        self.values.at_into(k, &mut v);
+        SlabBlocks::from_values(&v, self.thickness_nm)
     }
 }

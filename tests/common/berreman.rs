@@ -627,3 +627,106 @@ pub fn plate_reference(
 pub fn to_array(m: &Matrix3<C64>) -> [[C64; 3]; 3] {
     [0, 1, 2].map(|i| [0, 1, 2].map(|j| m[(i, j)]))
 }
+
+/// Reference solution for a stack: layers of permittivity `layers[i].0` (working frame) and
+/// thickness `layers[i].1` (in wavelengths), from the top down, between isotropic half-spaces
+/// `eps_top` (above) and `eps_bottom` (below). Reflection and transmission of waves incident
+/// from the top, in the textbook s/p bases of the half-spaces (as [`PlateRef`]; the
+/// transmitted wave referred to the bottom face), with their power ratios.
+#[derive(Clone, Copy, Debug)]
+pub struct StackRef {
+    /// Reflection of waves incident from the top.
+    pub r: Matrix2<C64>,
+    /// Transmission top → bottom.
+    pub t: Matrix2<C64>,
+    /// Power ratios of `r`.
+    pub power_r: Matrix2<f64>,
+    /// Power ratios of `t`.
+    pub power_t: Matrix2<f64>,
+    /// `|P_out| / |P_in|` of the s waves of the two half-spaces (0 if either carries none).
+    pub flux_ratio: f64,
+}
+
+/// [`StackRef`] by Redheffer star products of the interfaces' scattering matrices, top down,
+/// each layer's amplitudes referred to its bottom face by factors of modulus <= 1 (the scheme of
+/// [`try_plate_reference`], repeated per layer).
+pub fn try_stack_reference(
+    eps_top: C64,
+    layers: &[(Matrix3<C64>, f64)],
+    eps_bottom: C64,
+    beta: C64,
+) -> Result<StackRef, String> {
+    let top = isotropic_sp_waves(eps_top, beta)?;
+    let bottom = isotropic_sp_waves(eps_bottom, beta)?;
+    let media: Vec<Waves> = layers
+        .iter()
+        .map(|(eps, _)| waves(eps, beta))
+        .collect::<Result<_, _>>()?;
+    let id = Matrix2::<C64>::identity();
+    let i = C64::new(0.0, 1.0);
+    let mut above = top;
+    let mut s: Option<[[Matrix2<C64>; 2]; 2]> = None;
+    for (k, below) in media.iter().chain(std::iter::once(&bottom)).enumerate() {
+        let b = blocks(&interface_s(&above, below).ok_or("interface singular")?);
+        s = Some(match s {
+            None => b,
+            Some([[a11, a12], [a21, a22]]) => {
+                // Refer the layer-side amplitudes to the bottom face of layer k − 1.
+                let layer = &media[k - 1];
+                let k0d = 2.0 * std::f64::consts::PI * layers[k - 1].1;
+                let pd = Matrix2::from_diagonal(&nalgebra::Vector2::new(
+                    (-i * layer.down[0].q * k0d).exp(),
+                    (-i * layer.down[1].q * k0d).exp(),
+                ));
+                let pu = Matrix2::from_diagonal(&nalgebra::Vector2::new(
+                    (i * layer.up[0].q * k0d).exp(),
+                    (i * layer.up[1].q * k0d).exp(),
+                ));
+                let (a12, a21, a22) = (a12 * pu, pd * a21, pd * a22 * pu);
+                let [[b11, b12], [b21, b22]] = b;
+                let inv1 = (id - a22 * b11)
+                    .try_inverse()
+                    .ok_or("multiple-reflection matrix singular")?;
+                let inv2 = (id - b11 * a22)
+                    .try_inverse()
+                    .ok_or("multiple-reflection matrix singular")?;
+                [
+                    [a11 + a12 * b11 * inv1 * a21, a12 * inv2 * b12],
+                    [b21 * inv1 * a21, b22 + b21 * inv1 * a22 * b12],
+                ]
+            }
+        });
+        above = *below;
+    }
+    let [[r, _], [t, _]] = s.ok_or("no interface")?;
+    if [r, t]
+        .iter()
+        .any(|m| m.iter().any(|z| !z.re.is_finite() || !z.im.is_finite()))
+    {
+        return Err("non-finite stack amplitudes".into());
+    }
+    let pw = |m: &Matrix2<C64>, out: &[Wave; 2], inc: &[Wave; 2]| {
+        Matrix2::from_fn(|a, b| {
+            let fi = inc[b].flux().abs();
+            if fi > FLUX_FLOOR * inc[b].e.norm() * inc[b].h.norm() {
+                m[(a, b)].norm_sqr() * out[a].flux().abs() / fi
+            } else {
+                0.0
+            }
+        })
+    };
+    let (fi, fo) = (top.down[0].flux().abs(), bottom.down[0].flux().abs());
+    let carried = |w: &Wave| w.flux().abs() > FLUX_FLOOR * w.e.norm() * w.h.norm();
+    let flux_ratio = if carried(&top.down[0]) && carried(&bottom.down[0]) {
+        fo / fi
+    } else {
+        0.0
+    };
+    Ok(StackRef {
+        r,
+        t,
+        power_r: pw(&r, &top.up, &top.down),
+        power_t: pw(&t, &bottom.down, &top.down),
+        flux_ratio,
+    })
+}

@@ -424,6 +424,31 @@ def test_two_stacked_plates_are_not_exact_as_documented(t1, t2, angle2, low, hig
     assert low <= de <= high
 
 
+def test_the_two_plates_as_one_stack_are_exact_in_a_channel_render():
+    """The 50 + 50 um plates of the case above in contact, as the two layers of one
+    birefringentstack: its channel integral is that of the product (its own integration,
+    docs/physics.md, section 8), so against the same fixed-wavelength reference of the same
+    scene CIEDE2000 stays below 1 where the separate plates give 4-16, and render_analytic gives
+    the stack its channel (not its layers, which the stack would refuse) and no warning."""
+    from _common import layer
+    from channel_reference import reference
+
+    def scene() -> dict:
+        s = two_plates(50.0, 50.0, 45.0)
+        p1, p2 = s.pop("p1")["bsdf"], s.pop("p2")["bsdf"]
+        # Layers from the exterior (+z, towards the camera) down: the light meets p1 first.
+        s["stack"] = layer(0.0, 2, 2, {"type": "birefringentstack", "top": p2, "bottom": p1})
+        return s
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        ours = mb.render_analytic(scene(), spp=64)["rgb"].mean(axis=(0, 1))
+    ref = reference(scene(), 16)[..., 0, :].mean(axis=(0, 1))
+    de = ciede2000(ours, ref, 0.5)
+    print(f"50 + 50 um as one stack: CIEDE2000 {de:.2f}")
+    assert de < 1.0
+
+
 def lit_floor(rgb: list[float], thickness: float) -> dict:
     """A diffuse floor of colour `rgb` lit by a D65 area light through a quartz film of
     `thickness` um (axis along the normal: thin-film colours only) and seen from the side, not

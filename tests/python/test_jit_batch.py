@@ -39,6 +39,17 @@ def plate(polarized: bool, exit_ior: float = 1.33) -> dict:
             "exit_ior": exit_ior}
 
 
+def stack(polarized: bool) -> dict:
+    """A stack of a quartz plate and two tapes, each textured over the surface (a checkerboard of
+    thicknesses, axis angles and an added birefringence)."""
+    tape = {"type": "thinbirefringent", "eta_o": 1.47, "eta_e": 1.478}
+    return {"type": "birefringentstack", "ext_ior": 1.0, "exit_ior": 1.2,
+            "quartz": {"type": "thinbirefringent", "material": "quartz", "thickness": 12.0,
+                       "axis_angle": CHECKER(0.0, 60.0)},
+            "tape_1": dict(tape, thickness=CHECKER(20.0, 40.0), birefringence=CHECKER(0.0, 0.002)),
+            "tape_2": dict(tape, thickness=35.0, axis_angle=CHECKER(30.0, 100.0))}
+
+
 def crystal(polarized: bool) -> dict:
     if polarized:
         return {"type": "birefringent", "material": "calcite", "optic_axis": [0.3, 0.5, 0.8],
@@ -80,11 +91,11 @@ def scalar_answers(variant: str, make, mode: str, wi, uv, waves, u, null: bool):
 
 
 @pytest.mark.parametrize("variant", [v for v in LLVM if scalar_counterpart(v)])
-@pytest.mark.parametrize("kind", ["plate", "crystal", "null"])
+@pytest.mark.parametrize("kind", ["plate", "crystal", "null", "stack"])
 def test_llvm_batch_equals_scalar_lanes_bit_for_bit(variant, kind):
     polarized = "polarized" in variant
     makers = {"plate": lambda: plate(polarized), "crystal": lambda: crystal(polarized),
-              "null": lambda: plate(polarized, exit_ior=1.0)}
+              "null": lambda: plate(polarized, exit_ior=1.0), "stack": lambda: stack(polarized)}
     make = makers[kind]
     lanes = RGB_LANES if variant == "llvm_ad_rgb" and kind != "crystal" else LANES
     wi, uv, waves, u = inputs(seed=len(variant) * 7 + len(kind), lanes=lanes)

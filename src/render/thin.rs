@@ -1,0 +1,187 @@
+//! The lobes of a thin element on a surface (a plate or a stack of layers between an exterior
+//! above and an exit medium below, no geometric thickness in the scene): its specular reflection
+//! and its transmission, from either side and in both transport modes, in fixed slots (0
+//! reflection, 1 transmission), over a wavelength, bands or channel weights.
+//!
+//! The element is solved once, from `wi`'s side, for both lobes: in Importance mode that is each
+//! lobe's own incidence; in Radiance mode (light from the mirror direction, or from the far
+//! side) each lobe is the reversed path of the forward one ([`reversed`], the reciprocity of
+//! media with symmetric dielectric tensors). Light from below sees the element flipped
+//! ([`Thin::flipped`]: exterior and exit swapped, mirrored through `z = 0`), solved as if from
+//! above, its matrices mirrored back (`D M D`, `D = diag(1, 1, −1, −1)`).
+
+use crate::error::{Error, Result};
+use crate::optics::frame::PlaneFrame;
+use crate::optics::mueller::reversed;
+use crate::plate::slab::{Output, SlabMueller, Want};
+use crate::render::plate::Spectrum;
+use crate::render::{PathLobe, Transport};
+use nalgebra::{Matrix4, Vector3};
+use num_complex::Complex64 as C64;
+
+/// A thin element as the lobes need it.
+pub trait Thin: Sized {
+    /// Which lobes are asked for.
+    fn want(&self) -> Want;
+    /// Only `M00`.
+    fn output(&self) -> Output;
+    /// The exit medium absorbs whatever enters it: no transmission lobe, no light from below.
+    fn absorbing_exit(&self) -> bool;
+    /// Real index of the exterior (above, `z > 0`).
+    fn ext(&self) -> f64;
+    /// Real index of the exit medium (below).
+    fn exit(&self) -> f64;
+    /// The element seen from below: exterior and exit swapped, mirrored through `z = 0`.
+    fn flipped(&self) -> Self;
+    /// Mueller matrices (s/p frames) per channel of `spectrum` for light from above with
+    /// incidence parameter `beta` in the plane of `frame`.
+    fn evaluate(
+        &self,
+        spectrum: &Spectrum,
+        frame: PlaneFrame,
+        beta: C64,
+        want: Want,
+    ) -> Result<Vec<SlabMueller>>;
+}
+
+/// The element's lobes seen from `wi`, one `[reflection, transmission]` pair per spectral
+/// channel (module docs). `share`: one solve for both lobes (else each lobe solved on its own,
+/// the reference the shared solution is tested against).
+pub fn lobes<E: Thin>(
+    e: &E,
+    spectrum: &Spectrum,
+    wi: Vector3<f64>,
+    transport: Transport,
+    share: bool,
+) -> Result<Vec<[Option<PathLobe>; 2]>> {
+    if !(wi.iter().all(|x| x.is_finite()) && (wi.norm() - 1.0).abs() < 1e-4) {
+        return Err(Error::new("wi", "must be a unit vector"));
+    }
+    let channels = spectrum.channels()?;
+    spectrum.validate()?;
+    let mut out = vec![[None, None]; channels];
+    if wi.z == 0.0 || (e.absorbing_exit() && wi.z < 0.0) {
+        return Ok(out);
+    }
+    let mut want = e.want();
+    want.transmission &= !e.absorbing_exit();
+    let wi = wi.normalize();
+    let reflected = Vector3::new(-wi.x, -wi.y, wi.z);
+    let lobes = [
+        Some(reflected).filter(|_| want.reflection),
+        through(e, wi).filter(|_| want.transmission),
+    ];
+    let shared = if share {
+        let want = Want {
+            reflection: lobes[0].is_some(),
+            transmission: lobes[1].is_some(),
+        };
+        Some(physical(e, spectrum, wi, want)?)
+    } else {
+        None
+    };
+    for (component, wo) in lobes.into_iter().enumerate() {
+        let Some(wo) = wo else { continue };
+        let towards = match transport {
+            Transport::Importance => wi,
+            Transport::Radiance => wo,
+        };
+        let want = Want {
+            reflection: component == 0,
+            transmission: component == 1,
+        };
+        // Shared: solved from wi's side; a Radiance lobe is its reversed path.
+        let own;
+        let (ms, reverse): (&[SlabMueller], bool) = match &shared {
+            Some(ms) => (ms, transport == Transport::Radiance),
+            None => {
+                own = physical(e, spectrum, towards, want)?;
+                (&own, false)
+            }
+        };
+        let (n_in, n_out) = side_indices(e, towards, component);
+        let scale = match transport {
+            Transport::Radiance => (n_out / n_in).powi(2),
+            Transport::Importance => 1.0,
+        };
+        let s = PlaneFrame::from_direction(towards).s;
+        for (c, m) in ms.iter().enumerate() {
+            let m = if component == 0 { m.r } else { m.t };
+            let Some(m) = m else { continue };
+            let mut mueller = if reverse { reversed(&m) } else { m };
+            // A band-averaged coherency of an element that passes (almost) nothing can give M00
+            // a rounding-level negative (seen: -2e-22); under a non-negative weight the
+            // unpolarised throughput is >= 0. (A signed sRGB channel keeps its sign.)
+            if !spectrum.is_signed() {
+                mueller[(0, 0)] = mueller[(0, 0)].max(0.0);
+            }
+            let eta = match transport {
+                Transport::Radiance => n_in / n_out,
+                Transport::Importance => n_out / n_in,
+            };
+            out[c][component] = Some(
+                PathLobe::new(component, wo, (s, s), mueller, eta).with_radiance_factor(scale),
+            );
+        }
+    }
+    Ok(out)
+}
+
+/// Real indices `(n where the light arrives from, n where it leaves into)`.
+fn side_indices<E: Thin>(e: &E, towards: Vector3<f64>, component: usize) -> (f64, f64) {
+    let (near, far) = if towards.z > 0.0 {
+        (e.ext(), e.exit())
+    } else {
+        (e.exit(), e.ext())
+    };
+    (near, if component == 0 { near } else { far })
+}
+
+/// The direction on the far side of the element that is joined to `w` by transmission (Snell's
+/// law between the two isotropic media; `None` under total internal reflection).
+fn through<E: Thin>(e: &E, w: Vector3<f64>) -> Option<Vector3<f64>> {
+    let (n_near, n_far) = side_indices(e, w, 1);
+    let ratio = n_near / n_far;
+    let sin2 = ratio * ratio * (w.x * w.x + w.y * w.y);
+    if sin2 >= 1.0 {
+        return None;
+    }
+    let cos = (1.0 - sin2).sqrt();
+    Some(Vector3::new(
+        -w.x * ratio,
+        -w.y * ratio,
+        -w.z.signum() * cos,
+    ))
+}
+
+/// Mueller matrices (s/p frames) of light arriving from `towards` (either side), per channel:
+/// the element (flipped when `towards` is below) solved from above, mirrored back.
+fn physical<E: Thin>(
+    e: &E,
+    spectrum: &Spectrum,
+    towards: Vector3<f64>,
+    want: Want,
+) -> Result<Vec<SlabMueller>> {
+    let flipped;
+    let (e, w, mirrored) = if towards.z > 0.0 {
+        (e, towards, false)
+    } else {
+        flipped = e.flipped();
+        (
+            &flipped,
+            Vector3::new(towards.x, towards.y, -towards.z),
+            true,
+        )
+    };
+    let beta = C64::new(e.ext() * (w.x * w.x + w.y * w.y).sqrt(), 0.0);
+    let ms = e.evaluate(spectrum, PlaneFrame::from_direction(w), beta, want)?;
+    let d = Matrix4::from_diagonal(&nalgebra::Vector4::new(1.0, 1.0, -1.0, -1.0));
+    let fix = |m: Option<Matrix4<f64>>| m.map(|m| if mirrored { d * m * d } else { m });
+    Ok(ms
+        .into_iter()
+        .map(|m| SlabMueller {
+            r: fix(m.r),
+            t: fix(m.t),
+        })
+        .collect())
+}
