@@ -58,18 +58,15 @@ public:
 
     /// Exposes the parameters (eta_o and eta_e only for constant indices): the handles,
     /// differentiable, in the JIT variants; the values, not differentiable, in the scalar ones.
-    /// `differentiable = false`: the handles flagged not differentiable (a stack's layer).
-    void traverse(TraversalCallback *cb, bool differentiable = true) {
+    void traverse(TraversalCallback *cb) {
         if constexpr (Jit) {
-            const ParamFlags flags =
-                differentiable ? ParamFlags::Differentiable : ParamFlags::NonDifferentiable;
             if (!material.named) {
-                cb->put("eta_o", m_eta_o, flags);
-                cb->put("eta_e", m_eta_e, flags);
+                cb->put("eta_o", m_eta_o, ParamFlags::Differentiable);
+                cb->put("eta_e", m_eta_e, ParamFlags::Differentiable);
             }
-            cb->put("kappa_o", m_kappa_o, flags);
-            cb->put("kappa_e", m_kappa_e, flags);
-            cb->put("optic_axis", m_axis, flags);
+            cb->put("kappa_o", m_kappa_o, ParamFlags::Differentiable);
+            cb->put("kappa_e", m_kappa_e, ParamFlags::Differentiable);
+            cb->put("optic_axis", m_axis, ParamFlags::Differentiable);
         } else {
             if (!material.named) {
                 cb->put("eta_o", material.eta_o, ParamFlags::NonDifferentiable);

@@ -219,10 +219,9 @@ public:
     /// eta_o, eta_e, kappa_o, kappa_e, optic_axis and the textures' values are differentiable
     /// in the JIT variants (differentiable.h); the media, scales and band are not.
     void traverse(TraversalCallback *cb) override {
-        // A stack's layer: its gradients do not flow through the stack (not differentiable).
-        m_diff.traverse(cb, !m_nested);
-        const ParamFlags textures =
-            m_nested ? ParamFlags::NonDifferentiable : shim::texture_flags<Float>();
+        // (A stack's layer: the stack exposes it as not differentiable, birefringentstack.cpp.)
+        m_diff.traverse(cb);
+        const ParamFlags textures = shim::texture_flags<Float>();
         if (!m_nested) {
             cb->put("ext_ior", m_ext_ior, ParamFlags::NonDifferentiable);
             cb->put("exit_ior", m_exit_ior, ParamFlags::NonDifferentiable);

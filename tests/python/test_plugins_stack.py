@@ -219,6 +219,20 @@ def test_textures_per_layer_drive_the_stack():
         np.testing.assert_array_equal(lobe(s, si, "radiance", 1), want)
 
 
+def test_layers_are_not_differentiable():
+    """No gradient flows through a stack yet: a nested plate's parameters, differentiable on a
+    plate of its own in the llvm_ad variants, are flagged not differentiable as a layer (so
+    that Mitsuba refuses to differentiate them rather than give a zero gradient)."""
+    variant("llvm_ad_spectral_polarized")
+    plate = mi.traverse(mi.load_dict(layer()))
+    layers = mi.traverse(stack(layer(), layer(axis_angle=45.0)))
+    nondiff = int(mi.ParamFlags.NonDifferentiable)
+    for key in ("eta_o", "kappa_e", "optic_axis", "thickness.value", "axis_angle.value"):
+        if key in plate:
+            assert not plate.flags(key) & nondiff, key
+        assert layers.flags(f"layer_1.{key}") & nondiff, key
+
+
 @pytest.mark.parametrize("name", mitsuba_birefringent.VARIANTS)
 def test_every_variant_loads_and_samples(name):
     variant(name)
