@@ -167,27 +167,10 @@ private:
         for (size_t k = 0; k < m_sources.size(); ++k)
             m_material_index[k] = (uint32_t) k;
         m_band = bfr::band_spectrum(m_filter_bandwidth);
-        if constexpr (is_spectral_v<Spectrum>)
-            m_spectrum = bfr::band_spectrum(m_filter_bandwidth);
-        else if constexpr (is_rgb_v<Spectrum>)
-            m_spectrum = bfr::srgb_spectrum();
-        else
-            m_spectrum = shim::core_call(ClassName, [&] { return bfr::colour_channel_spectrum(m_channel); });
+        m_spectrum = shim::thin_spectrum<Spectrum>(m_filter_bandwidth, m_channel, ClassName);
         m_null = m_exit_ior == m_ext_ior && !m_absorbing_exit;
-        uint32_t aniso = isotropic ? 0u : (uint32_t) BSDFFlags::Anisotropic;
-        uint32_t sides = (uint32_t) (BSDFFlags::FrontSide | BSDFFlags::BackSide) | aniso;
-        m_types[0] = BSDFFlags::DeltaReflection;
-        m_types[1] = m_null ? BSDFFlags::Null : BSDFFlags::DeltaTransmission;
-        m_components.clear();
-        if (m_absorbing_exit) {
-            m_components.push_back((uint32_t) m_types[0] | (uint32_t) BSDFFlags::FrontSide | aniso);
-            m_flags = m_components[0];
-        } else {
-            uint32_t asym = m_exit_ior != m_ext_ior ? (uint32_t) BSDFFlags::NonSymmetric : 0u;
-            m_components.push_back((uint32_t) m_types[0] | sides);
-            m_components.push_back((uint32_t) m_types[1] | sides | asym);
-            m_flags = m_components[0] | m_components[1];
-        }
+        shim::thin_flags(isotropic, m_null, m_absorbing_exit, m_exit_ior != m_ext_ior, m_types,
+                         m_components, m_flags);
         check_at_load();
     }
 

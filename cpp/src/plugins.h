@@ -111,6 +111,43 @@ void fill_path_lanes(Lanes &lanes, ChunkBuffers<Cap, In> &b, const HostInputs<Fl
         b.convert(wave0 + w, in.floats(c.first_wave + w), begin, end);
 }
 
+/// The spectrum a thin element (a plate or a stack) is queried over in the variant of
+/// `Spectrum`: a band of `filter_bandwidth` around each sampled wavelength, the sRGB channels,
+/// or the mono variants' `channel` (refused by the core with its reason if unknown).
+template <typename Spectrum>
+rust::Box<bfr::PlateSpectrum> thin_spectrum(double filter_bandwidth, const std::string &channel,
+                                            const char *ClassName) {
+    if constexpr (is_spectral_v<Spectrum>)
+        return bfr::band_spectrum(filter_bandwidth);
+    else if constexpr (is_rgb_v<Spectrum>)
+        return bfr::srgb_spectrum();
+    else
+        return core_call(ClassName, [&] { return bfr::colour_channel_spectrum(channel); });
+}
+
+/// The lobe types and BSDF flags of a thin element: delta reflection, and delta transmission
+/// (null between equal non-absorbing media, `null`) unless the exit medium absorbs, when only
+/// the front side reflects. Between different indices the transmission's Radiance weight
+/// carries the radiance factor (n_wi / n_wo)^2 and its Importance weight does not
+/// (NonSymmetric; see birefringent.cpp).
+inline void thin_flags(bool isotropic, bool null, bool absorbing_exit, bool asymmetric,
+                       BSDFFlags (&types)[2], std::vector<uint32_t> &components, uint32_t &flags) {
+    uint32_t aniso = isotropic ? 0u : (uint32_t) BSDFFlags::Anisotropic;
+    uint32_t sides = (uint32_t) (BSDFFlags::FrontSide | BSDFFlags::BackSide) | aniso;
+    types[0] = BSDFFlags::DeltaReflection;
+    types[1] = null ? BSDFFlags::Null : BSDFFlags::DeltaTransmission;
+    components.clear();
+    if (absorbing_exit) {
+        components.push_back((uint32_t) types[0] | (uint32_t) BSDFFlags::FrontSide | aniso);
+        flags = components[0];
+    } else {
+        uint32_t asym = asymmetric ? (uint32_t) BSDFFlags::NonSymmetric : 0u;
+        components.push_back((uint32_t) types[0] | sides);
+        components.push_back((uint32_t) types[1] | sides | asym);
+        flags = components[0] | components[1];
+    }
+}
+
 /// Defined in thinbirefringent.cpp, birefringent.cpp and birefringentstack.cpp.
 void register_thinbirefringent();
 void register_birefringent();

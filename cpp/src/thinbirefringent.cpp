@@ -251,30 +251,11 @@ private:
         auto [material, axis] = m_diff.updated();
         m_material = shim::make_material(material, ClassName);
         m_band = bfr::band_spectrum(m_filter_bandwidth);
-        if constexpr (is_spectral_v<Spectrum>)
-            m_spectrum = bfr::band_spectrum(m_filter_bandwidth);
-        else if constexpr (is_rgb_v<Spectrum>)
-            m_spectrum = bfr::srgb_spectrum();
-        else
-            m_spectrum = shim::core_call(ClassName, [&] { return bfr::colour_channel_spectrum(m_channel); });
+        m_spectrum = shim::thin_spectrum<Spectrum>(m_filter_bandwidth, m_channel, ClassName);
         m_null = m_exit_ior == m_ext_ior && !m_absorbing_exit;
         bool isotropic = m_material->is_isotropic(0) && !m_birefringence;
-        uint32_t aniso = isotropic ? 0u : (uint32_t) BSDFFlags::Anisotropic;
-        uint32_t sides = (uint32_t) (BSDFFlags::FrontSide | BSDFFlags::BackSide) | aniso;
-        m_types[0] = BSDFFlags::DeltaReflection;
-        m_types[1] = m_null ? BSDFFlags::Null : BSDFFlags::DeltaTransmission;
-        m_components.clear();
-        if (m_absorbing_exit) {
-            m_components.push_back((uint32_t) m_types[0] | (uint32_t) BSDFFlags::FrontSide | aniso);
-            m_flags = m_components[0];
-        } else {
-            // Between different indices the transmission's Radiance weight carries the radiance
-            // factor (n_wi / n_wo)^2 and its Importance weight does not (see birefringent.cpp).
-            uint32_t asym = m_exit_ior != m_ext_ior ? (uint32_t) BSDFFlags::NonSymmetric : 0u;
-            m_components.push_back((uint32_t) m_types[0] | sides);
-            m_components.push_back((uint32_t) m_types[1] | sides | asym);
-            m_flags = m_components[0] | m_components[1];
-        }
+        shim::thin_flags(isotropic, m_null, m_absorbing_exit, m_exit_ior != m_ext_ior, m_types,
+                         m_components, m_flags);
         check_at_load(axis);
         m_diff.commit(material, axis);
         warn_of_units();

@@ -7,7 +7,7 @@ use super::output::{complex, num};
 use crate::error::{Error, Result};
 use crate::optics::surface::Surface;
 use crate::params::{Length, Thickness};
-use crate::plate::slab::{Slab, Want};
+use crate::plate::slab::{Slab, SlabJones, Want};
 use crate::plate::Plate;
 use nalgebra::{Matrix2, Matrix4};
 use num_complex::Complex64 as C64;
@@ -74,8 +74,21 @@ pub fn run_monochromatic(input: &Value, fields: &[&str]) -> Result<Value> {
     let q = read(&mut f)?;
     let optics = q.slab.optics(&q.frame, q.beta)?;
     let j = optics.jones(q.wavelength_nm, Want::BOTH)?;
+    monochromatic_output("slab", "plate", &j, q.beta, &q.warnings)
+}
+
+/// The output of `slab` (or `stack`, `subcommand`) at one wavelength from the element's Jones
+/// matrices `j`: powers, Jones and Mueller matrices of both lobes, the incidence parameter and
+/// the warnings; refused if the element (`what`) would create energy.
+pub(super) fn monochromatic_output(
+    subcommand: &str,
+    what: &str,
+    j: &SlabJones,
+    beta: C64,
+    warnings: &[String],
+) -> Result<Value> {
     let (r, t) = (j.r.unwrap_or_default(), j.t.unwrap_or_default());
-    check_passive("slab", "plate", &r, &t)?;
+    check_passive(subcommand, what, &r, &t)?;
     let mut out = Map::new();
     out.insert("R".into(), powers(&r));
     out.insert("T".into(), powers(&t));
@@ -88,8 +101,8 @@ pub fn run_monochromatic(input: &Value, fields: &[&str]) -> Result<Value> {
         "mueller".into(),
         json!({"R": matrix(&mr), "T": matrix(&mt)}),
     );
-    out.insert("beta".into(), complex(q.beta));
-    super::output::insert_warnings(&mut out, &q.warnings);
+    out.insert("beta".into(), complex(beta));
+    super::output::insert_warnings(&mut out, warnings);
     Ok(Value::Object(out))
 }
 

@@ -4,8 +4,7 @@
 use super::input::Fields;
 use super::interface::read_incidence;
 use super::media;
-use super::output::{complex, insert_warnings};
-use super::slab::{check_passive, jones, matrix, powers};
+use super::slab::monochromatic_output;
 use super::spectrum::{
     band_range, band_weight, channel_names, encode, read_request, step_field, Over, RANGE,
 };
@@ -21,7 +20,7 @@ use crate::stack::spectral::{quadrature, StackModel};
 use crate::stack::{in_layer, Layer, Stack};
 use nalgebra::Vector3;
 use num_complex::Complex64 as C64;
-use serde_json::{json, Map, Value};
+use serde_json::Value;
 
 /// Fields of the `stack` subcommand.
 pub const FIELDS: [&str; 9] = [
@@ -148,23 +147,7 @@ fn read_layer(v: &Value, wavelength_nm: f64) -> Result<(Layer, Option<String>)> 
 fn monochromatic(q: &StackInput) -> Result<Value> {
     let j = StackBlocks::new(&q.stack, q.wavelength_nm, &q.frame, q.beta)?
         .jones(q.wavelength_nm, Want::BOTH)?;
-    let (r, t) = (j.r.unwrap_or_default(), j.t.unwrap_or_default());
-    check_passive("stack", "stack", &r, &t)?;
-    let mut out = Map::new();
-    out.insert("R".into(), powers(&r));
-    out.insert("T".into(), powers(&t));
-    out.insert("jones".into(), json!({"R": jones(&r), "T": jones(&t)}));
-    let (mr, mt) = (
-        crate::optics::mueller::from_jones(&r),
-        crate::optics::mueller::from_jones(&t),
-    );
-    out.insert(
-        "mueller".into(),
-        json!({"R": matrix(&mr), "T": matrix(&mt)}),
-    );
-    out.insert("beta".into(), complex(q.beta));
-    insert_warnings(&mut out, &q.warnings);
-    Ok(Value::Object(out))
+    monochromatic_output("stack", "stack", &j, q.beta, &q.warnings)
 }
 
 /// The stack over the `spectrum` object `spec`: the output of `slab` with a spectrum.
