@@ -1,111 +1,114 @@
 //! Fast complex elementary functions and small dense solves used on hot paths.
 
+use crate::error::{Error, Result};
+use crate::real::complex::{self, Cx};
+use crate::real::{Mask, Real, Select};
 use nalgebra::{Matrix2, Matrix4};
 use num_complex::Complex64 as C64;
 use std::ops::{Add, Mul, Neg, Sub};
 
-/// The field of a small dense solve: `f64`, or `C64` when imaginary parts are present (a
-/// system whose entries are all real is solved in real arithmetic, to the same result).
-pub trait Scalar:
+/// The field of a small dense solve or a field computation over the real numbers `R` (`f64`
+/// on the host, a recorded number in a program): `R` itself, or `Complex<R>` when imaginary
+/// parts are present (a system whose entries are all real is solved in real arithmetic, to the
+/// same result).
+pub trait Scalar<R: Real>:
     Copy
     + Add<Output = Self>
     + Sub<Output = Self>
     + Mul<Output = Self>
-    + Mul<f64, Output = Self>
+    + Mul<R, Output = Self>
     + Neg<Output = Self>
+    + Select<R::Mask>
 {
     /// Zero.
-    const ZERO: Self;
+    fn zero() -> Self;
     /// One.
-    const ONE: Self;
+    fn one() -> Self;
     /// `|z|²`.
-    fn norm_sqr(self) -> f64;
+    fn norm_sqr(self) -> R;
     /// `1/z` ([`inv`] for complex numbers: `z̄ · (1/|z|²)`, as for real ones).
     fn inverse(self) -> Self;
     /// Complex conjugate.
     fn conj(self) -> Self;
     /// Real part.
-    fn re(self) -> f64;
+    fn re(self) -> R;
     /// As a complex number.
-    fn complex(self) -> C64;
+    fn complex(self) -> Cx<R>;
 }
 
-impl Scalar for f64 {
-    const ZERO: Self = 0.0;
-    const ONE: Self = 1.0;
+impl<R: Real> Scalar<R> for R {
     #[inline(always)]
-    fn norm_sqr(self) -> f64 {
+    fn zero() -> Self {
+        R::zero()
+    }
+    #[inline(always)]
+    fn one() -> Self {
+        R::one()
+    }
+    #[inline(always)]
+    fn norm_sqr(self) -> R {
         self * self
     }
     #[inline(always)]
     fn inverse(self) -> Self {
-        self * (1.0 / (self * self))
+        self * (self * self).recip()
     }
     #[inline(always)]
     fn conj(self) -> Self {
         self
     }
     #[inline(always)]
-    fn re(self) -> f64 {
+    fn re(self) -> R {
         self
     }
     #[inline(always)]
-    fn complex(self) -> C64 {
-        C64::new(self, 0.0)
+    fn complex(self) -> Cx<R> {
+        Cx::new(self, R::zero())
     }
 }
 
-impl Scalar for C64 {
-    const ZERO: Self = C64::new(0.0, 0.0);
-    const ONE: Self = C64::new(1.0, 0.0);
+impl<R: Real> Scalar<R> for Cx<R> {
     #[inline(always)]
-    fn norm_sqr(self) -> f64 {
-        C64::norm_sqr(&self)
+    fn zero() -> Self {
+        Cx::new(R::zero(), R::zero())
+    }
+    #[inline(always)]
+    fn one() -> Self {
+        Cx::new(R::one(), R::zero())
+    }
+    #[inline(always)]
+    fn norm_sqr(self) -> R {
+        self.re * self.re + self.im * self.im
     }
     #[inline(always)]
     fn inverse(self) -> Self {
-        inv(self)
+        complex::inv(self)
     }
     #[inline(always)]
     fn conj(self) -> Self {
-        C64::conj(&self)
+        Cx::new(self.re, -self.im)
     }
     #[inline(always)]
-    fn re(self) -> f64 {
+    fn re(self) -> R {
         self.re
     }
     #[inline(always)]
-    fn complex(self) -> C64 {
+    fn complex(self) -> Cx<R> {
         self
     }
 }
 
 /// Principal square root (`Re ≥ 0`, branch cut on the negative real axis, `sqrt(−x ± 0i) =
-/// ±i√x`), by the algebraic formula without trigonometry and without cancellation.
+/// ±i√x`): [`complex::sqrt`] on `f64`.
 #[inline]
 pub fn sqrt(z: C64) -> C64 {
-    if z.im == 0.0 {
-        return if z.re >= 0.0 {
-            C64::new(z.re.sqrt(), z.im)
-        } else {
-            C64::new(0.0, (-z.re).sqrt().copysign(z.im))
-        };
-    }
-    let m = z.re.hypot(z.im);
-    if z.re >= 0.0 {
-        let t = (0.5 * (m + z.re)).sqrt();
-        C64::new(t, z.im / (2.0 * t))
-    } else {
-        let t = (0.5 * (m - z.re)).sqrt();
-        C64::new(z.im.abs() / (2.0 * t), t.copysign(z.im))
-    }
+    complex::sqrt(z)
 }
 
 /// `1/z` with one real division (`z̄ · (1/|z|²)`); within an ulp or two of `z.inv()`.
 #[inline]
 pub fn inv(z: C64) -> C64 {
-    let r = 1.0 / z.norm_sqr();
-    C64::new(z.re * r, -z.im * r)
+    complex::inv(z)
 }
 
 /// Solves `A X = B` for a 4×4 complex `A` and 4×4 `B` by Gaussian elimination with partial
@@ -121,29 +124,45 @@ pub fn solve4(a: &Matrix4<C64>, b: &Matrix4<C64>) -> Option<Matrix4<C64>> {
 }
 
 /// [`solve4`] for several right-hand sides at once (one elimination), in the arithmetic of `T`.
-pub fn solve4_columns<T: Scalar + nalgebra::Scalar, const N: usize>(
+pub fn solve4_columns<T: Scalar<f64> + nalgebra::Scalar, const N: usize>(
     a: &Matrix4<T>,
     b: &[Matrix4<T>; N],
 ) -> Option<[Matrix4<T>; N]> {
+    eliminate4(a, b).ok()
+}
+
+/// Solves `A X = B` for a 4×4 `A` and `N` right-hand sides by Gauss–Jordan elimination with
+/// partial pivoting, over the reals `R` (the pivot row of each column is the one of largest
+/// modulus, moved up by per-lane exchanges); fails where a pivot is below `1e-300` of the
+/// largest entry of `A` (squared moduli) or NaN: the singular error of an interface.
+pub fn eliminate4<R: Real, T: Scalar<R> + nalgebra::Scalar, const N: usize>(
+    a: &Matrix4<T>,
+    b: &[Matrix4<T>; N],
+) -> Result<[Matrix4<T>; N]> {
     // Rows of A, and of every B, eliminated together.
     let mut m: [[T; 4]; 4] = std::array::from_fn(|i| std::array::from_fn(|j| a[(i, j)]));
     let mut r: [[[T; 4]; N]; 4] =
         std::array::from_fn(|i| std::array::from_fn(|k| std::array::from_fn(|j| b[k][(i, j)])));
-    let scale = a.iter().map(|z| z.norm_sqr()).fold(0.0, f64::max);
+    let scale = a
+        .iter()
+        .map(|z| z.norm_sqr())
+        .fold(R::zero(), |acc, x| acc.max(x));
     for col in 0..4 {
-        let mut pivot = col;
         for i in col + 1..4 {
-            if m[i][col].norm_sqr() > m[pivot][col].norm_sqr() {
-                pivot = i;
+            let larger = m[i][col].norm_sqr().gt(m[col][col].norm_sqr());
+            if larger.known() != Some(false) {
+                let (top, other) = (m[col], m[i]);
+                m[col] = Select::select(larger, other, top);
+                m[i] = Select::select(larger, top, other);
+                let (top, other) = (r[col], r[i]);
+                r[col] = Select::select(larger, other, top);
+                r[i] = Select::select(larger, top, other);
             }
         }
-        let p = m[pivot][col];
-        if p.norm_sqr().is_nan() || p.norm_sqr() <= 1e-300 * scale {
-            return None;
-        }
-        m.swap(col, pivot);
-        r.swap(col, pivot);
-        let inv = p.inverse();
+        let p = m[col][col];
+        let negligible = !p.norm_sqr().gt(scale * 1e-300);
+        negligible.fail(singular)?;
+        let inv = negligible.when(T::one, || p).inverse();
         for v in m[col].iter_mut().skip(col) {
             *v = *v * inv;
         }
@@ -168,7 +187,15 @@ pub fn solve4_columns<T: Scalar + nalgebra::Scalar, const N: usize>(
             }
         }
     }
-    Some(std::array::from_fn(|k| Matrix4::from_fn(|i, j| r[i][k][j])))
+    Ok(std::array::from_fn(|k| Matrix4::from_fn(|i, j| r[i][k][j])))
+}
+
+/// The error of a singular boundary system.
+pub(crate) fn singular() -> Error {
+    Error::new(
+        "interface",
+        "the boundary system is singular for this incidence (a guided or degenerate mode)",
+    )
 }
 
 /// `a b` for 4×4 complex matrices, written out (the generic product is several times slower).

@@ -14,6 +14,8 @@ pub mod material;
 pub mod optics;
 pub mod params;
 pub mod plate;
+pub mod real;
+pub mod record;
 pub mod render;
 pub mod scratch;
 pub mod spectral;

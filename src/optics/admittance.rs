@@ -24,13 +24,15 @@
 //! `|h_k^O| > |e_k^O|` (the same choice: the form's coefficients stay bounded by 1). The
 //! eliminating transformation is invertible, so the 4x4 system is singular exactly when `L` is.
 
-use crate::cmath::Scalar;
-use num_complex::Complex64 as C64;
+use crate::cmath::{singular, Scalar};
+use crate::error::Result;
+use crate::real::complex::Cx;
+use crate::real::{Mask, Real};
 
 /// Outgoing amplitudes for unit incoming ones: rows are the outgoing waves (two each side),
 /// columns the incoming waves `[x_in s, x_in p, y_in 0, y_in 1]`.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Solution<T = C64> {
+pub struct Solution<T> {
     /// Outgoing waves of the isotropic medium, `[s, p]`.
     pub x: [[T; 4]; 2],
     /// Outgoing waves of the other medium.
@@ -46,26 +48,31 @@ const ROWS: [(usize, usize); 2] = [(1, 2), (0, 3)];
 
 /// Solves the boundary system with the isotropic medium's modes `iso_in`, `iso_out` (`[s, p]`,
 /// tangential `ψ`) and the other medium's `other_in`, `other_out` (any two modes each).
-/// `None` if the reduced system is singular to working precision.
+/// Fails where the reduced system is singular to working precision ([`singular`]).
 ///
 /// When every field is real (lossless media, propagating waves: the common case) the same
 /// steps run in real arithmetic, which is what the complex ones reduce to then.
 #[inline]
-pub fn solve(
-    iso_in: &Pair<C64>,
-    iso_out: &Pair<C64>,
-    other_in: &Pair<C64>,
-    other_out: &Pair<C64>,
-) -> Option<Solution> {
+pub fn solve<R: Real>(
+    iso_in: &Pair<Cx<R>>,
+    iso_out: &Pair<Cx<R>>,
+    other_in: &Pair<Cx<R>>,
+    other_out: &Pair<Cx<R>>,
+) -> Result<Solution<Cx<R>>> {
     let all = [iso_in, iso_out, other_in, other_out];
-    if all.iter().all(|p| p.iter().flatten().all(|z| z.im == 0.0)) {
+    let zero = R::zero();
+    let real_fields = all
+        .iter()
+        .flat_map(|p| p.iter().flatten())
+        .fold(R::Mask::cst(true), |m, z| m & z.im.equals(zero));
+    if real_fields.surely() {
         let s = solve_in(
             &real(iso_in),
             &real(iso_out),
             &real(other_in),
             &real(other_out),
         )?;
-        return Some(Solution {
+        return Ok(Solution {
             x: complex(&s.x),
             y: complex(&s.y),
         });
@@ -75,32 +82,29 @@ pub fn solve(
 
 /// The real parts.
 #[inline(always)]
-fn real(p: &Pair<C64>) -> Pair<f64> {
-    let r = |m: &[C64; 4]| [m[0].re, m[1].re, m[2].re, m[3].re];
+fn real<R: Real>(p: &Pair<Cx<R>>) -> Pair<R> {
+    let r = |m: &[Cx<R>; 4]| [m[0].re, m[1].re, m[2].re, m[3].re];
     [r(&p[0]), r(&p[1])]
 }
 
 /// As complex numbers.
 #[inline(always)]
-fn complex(p: &Pair<f64>) -> Pair<C64> {
-    let c = |m: &[f64; 4]| {
-        let z = |x: f64| C64::new(x, 0.0);
-        [z(m[0]), z(m[1]), z(m[2]), z(m[3])]
-    };
+fn complex<R: Real>(p: &Pair<R>) -> Pair<Cx<R>> {
+    let c = |m: &[R; 4]| m.map(|x| Cx::new(x, R::zero()));
     [c(&p[0]), c(&p[1])]
 }
 
 /// [`solve`] in the arithmetic of `T`.
 #[inline]
-fn solve_in<T: Scalar>(
+fn solve_in<R: Real, T: Scalar<R>>(
     iso_in: &Pair<T>,
     iso_out: &Pair<T>,
     other_in: &Pair<T>,
     other_out: &Pair<T>,
-) -> Option<Solution<T>> {
+) -> Result<Solution<T>> {
     let rows = [Row::new(&iso_out[0], 0), Row::new(&iso_out[1], 1)];
-    let mut l = [[T::ZERO; 2]; 2];
-    let mut rhs = [[T::ZERO; 4]; 2];
+    let mut l = [[T::zero(); 2]; 2];
+    let mut rhs = [[T::zero(); 4]; 2];
     for (k, row) in rows.iter().enumerate() {
         rhs[k][k] = row.form(&iso_in[k]);
         for j in 0..2 {
@@ -113,17 +117,15 @@ fn solve_in<T: Scalar>(
         rows[0].back_substitute(iso_in, other_in, other_out, &y),
         rows[1].back_substitute(iso_in, other_in, other_out, &y),
     ];
-    Some(Solution { x, y })
+    Ok(Solution { x, y })
 }
 
 /// The two rows `E(k)`, `H(k)` of isotropic polarisation `k`, ordered `(lead, second)` so that
 /// the outgoing wave's `lead` component is the larger one: the back-substitution row and the
-/// normalisation of the eliminating form.
-struct Row<T> {
-    /// Index in `ψ` of the lead row.
-    lead: usize,
-    /// Index in `ψ` of the second row.
-    second: usize,
+/// normalisation of the eliminating form. Which row leads is a lane's choice.
+struct Row<R: Real, T> {
+    /// True where the `E(k)` row leads (else the `H(k)` row).
+    e_leads: R::Mask,
     /// `1 / lead(O)`.
     inv: T,
     /// `second(O) / lead(O)`: the admittance `Y_k` or its inverse, modulus ≤ 1.
@@ -132,21 +134,18 @@ struct Row<T> {
     k: usize,
 }
 
-impl<T: Scalar> Row<T> {
+impl<R: Real, T: Scalar<R>> Row<R, T> {
     #[inline(always)]
     fn new(out: &[T; 4], k: usize) -> Self {
         let (e, h) = ROWS[k];
-        let (lead, second) = if out[e].norm_sqr() >= out[h].norm_sqr() {
-            (e, h)
-        } else {
-            (h, e)
-        };
-        let inv = out[lead].inverse();
+        let e_leads = out[e].norm_sqr().ge(out[h].norm_sqr());
+        let lead = T::select(e_leads, out[e], out[h]);
+        let second = T::select(e_leads, out[h], out[e]);
+        let inv = lead.inverse();
         Row {
-            lead,
-            second,
+            e_leads,
             inv,
-            ratio: out[second] * inv,
+            ratio: second * inv,
             k,
         }
     }
@@ -154,7 +153,11 @@ impl<T: Scalar> Row<T> {
     /// `(lead, second)` components of `ψ`.
     #[inline(always)]
     fn split(&self, psi: &[T; 4]) -> (T, T) {
-        (psi[self.lead & 3], psi[self.second & 3])
+        let (e, h) = ROWS[self.k];
+        (
+            T::select(self.e_leads, psi[e], psi[h]),
+            T::select(self.e_leads, psi[h], psi[e]),
+        )
     }
 
     /// The lead component of `ψ` (its back-substitution row).
@@ -175,7 +178,7 @@ impl<T: Scalar> Row<T> {
         y: &Pair<T>,
     ) -> [T; 4] {
         let (a0, a1) = (self.lead(&other_out[0]), self.lead(&other_out[1]));
-        let mut x = [T::ZERO; 4];
+        let mut x = [T::zero(); 4];
         x[self.k] = -self.lead(&iso_in[self.k]);
         x[2] = self.lead(&other_in[0]);
         x[3] = self.lead(&other_in[1]);
@@ -195,46 +198,55 @@ impl<T: Scalar> Row<T> {
 }
 
 /// Solves `L X = B` (2x2 `L`, four right-hand sides) by Gaussian elimination with partial
-/// pivoting; `None` if `L` is singular to working precision (the criterion of
-/// [`crate::cmath::solve4`]: a pivot below `1e-300` of the largest entry, squared moduli).
+/// pivoting; fails where `L` is singular to working precision (a pivot below `1e-300` of the
+/// largest entry, squared moduli: the criterion of [`crate::cmath::solve4`]).
 #[inline]
-fn solve2<T: Scalar>(l: &[[T; 2]; 2], b: &Pair<T>) -> Option<Pair<T>> {
-    let scale = l.iter().flatten().map(|z| z.norm_sqr()).fold(0.0, f64::max);
-    let (top, bottom) = if l[1][0].norm_sqr() > l[0][0].norm_sqr() {
-        (1, 0)
-    } else {
-        (0, 1)
+fn solve2<R: Real, T: Scalar<R>>(l: &[[T; 2]; 2], b: &Pair<T>) -> Result<Pair<T>> {
+    let scale = l
+        .iter()
+        .flatten()
+        .map(|z| z.norm_sqr())
+        .fold(R::zero(), |a, x| a.max(x));
+    // The pivot row is the one with the larger first entry: `top`, the other `bottom`.
+    let swap = l[1][0].norm_sqr().gt(l[0][0].norm_sqr());
+    let pick = |top: bool, a: T, b: T| {
+        if top {
+            T::select(swap, b, a)
+        } else {
+            T::select(swap, a, b)
+        }
     };
-    let p0 = l[top][0];
-    if negligible(p0, scale) {
-        return None;
-    }
+    let row = |top: bool, i: usize| pick(top, l[0][i], l[1][i]);
+    let rhs = |top: bool, col: usize| pick(top, b[0][col], b[1][col]);
+    let (top, bottom) = (true, false);
+    let p0 = pivot(row(top, 0), scale)?;
     let inv0 = p0.inverse();
-    let m = l[bottom][0] * inv0;
-    let p1 = l[bottom][1] - m * l[top][1];
-    if negligible(p1, scale) {
-        return None;
-    }
+    let m = row(bottom, 0) * inv0;
+    let p1 = pivot(row(bottom, 1) - m * row(top, 1), scale)?;
     let inv1 = p1.inverse();
-    let mut x = [[T::ZERO; 4]; 2];
+    let mut x = [[T::zero(); 4]; 2];
     for col in 0..4 {
-        let x1 = (b[bottom][col] - m * b[top][col]) * inv1;
+        let x1 = (rhs(bottom, col) - m * rhs(top, col)) * inv1;
         x[1][col] = x1;
-        x[0][col] = (b[top][col] - l[top][1] * x1) * inv0;
+        x[0][col] = (rhs(top, col) - row(top, 1) * x1) * inv0;
     }
-    Some(x)
+    Ok(x)
 }
 
-/// A pivot too small to divide by (or NaN), relative to `scale` (largest squared modulus).
+/// `pivot`, or the singular error where it is too small to divide by (or NaN) relative to
+/// `scale` (largest squared modulus); while recording such lanes fail and divide by one.
 #[inline]
-fn negligible<T: Scalar>(pivot: T, scale: f64) -> bool {
+fn pivot<R: Real, T: Scalar<R>>(pivot: T, scale: R) -> Result<T> {
     let n = pivot.norm_sqr();
-    n.is_nan() || n <= 1e-300 * scale
+    let negligible = !n.gt(scale * 1e-300);
+    negligible.fail(singular)?;
+    Ok(negligible.when(T::one, || pivot))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use num_complex::Complex64 as C64;
 
     #[test]
     fn solve2_inverts_and_detects_singular() {
@@ -244,7 +256,7 @@ mod tests {
             [c(1.0, 0.0), c(0.0, 1.0), c(2.0, -3.0), c(0.1, 0.0)],
             [c(0.0, 0.0), c(1.0, 1.0), c(-1.0, 0.5), c(0.0, 0.7)],
         ];
-        let x = solve2(&l, &b).unwrap();
+        let x = solve2::<f64, C64>(&l, &b).unwrap();
         for i in 0..2 {
             for col in 0..4 {
                 let r = l[i][0] * x[0][col] + l[i][1] * x[1][col] - b[i][col];
@@ -252,7 +264,7 @@ mod tests {
             }
         }
         let s = [[c(1.0, 1.0), c(2.0, 2.0)], [c(0.5, 0.5), c(1.0, 1.0)]];
-        assert!(solve2(&s, &b).is_none());
+        assert!(solve2::<f64, C64>(&s, &b).is_err());
     }
 
     /// The real arithmetic does exactly what the complex one does on real fields: the same
@@ -274,7 +286,7 @@ mod tests {
                 p
             };
             let (a, b, c, d) = (pair(true), pair(true), pair(false), pair(false));
-            let real = solve_in(&a, &b, &c, &d).unwrap();
+            let real = solve_in::<f64, f64>(&a, &b, &c, &d).unwrap();
             let z = |p: &Pair<f64>| complex(p);
             let full = solve_in(&z(&a), &z(&b), &z(&c), &z(&d)).unwrap();
             for (r, f) in [(&real.x, &full.x), (&real.y, &full.y)] {

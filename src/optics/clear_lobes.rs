@@ -12,11 +12,11 @@
 //! row of amplitudes (outgoing) or column (incoming) in the first row or column, the rest 0.
 //! Ray directions are the Poynting vectors' (eq. S12), ray indices `k·ŝ` (eq. S14).
 
+use crate::cmath::singular;
 use crate::cmath::Scalar;
 use crate::error::{Error, Result};
 use crate::optics::fields::{Fields, Wave};
 use crate::optics::frame::PlaneFrame;
-use crate::optics::interface::singular;
 use crate::optics::lobes::{incidence, Event, Lobe};
 use crate::optics::modes::{uniaxial_normals, ModeKind};
 use crate::optics::mueller;
@@ -128,7 +128,7 @@ impl At<'_> {
     /// The event with the exterior's up-going normal component `w`, the crystal's normal
     /// components `q = [o↓, e↓, o↑, e↑]` and fields, and the up-going e-wave's `(εk)_z` if it
     /// propagates: its lobes to `sink` ([`each_clear_lobe`]).
-    fn event<T: Scalar>(
+    fn event<T: Scalar<f64>>(
         &self,
         w: T,
         q: [T; 4],
@@ -138,11 +138,11 @@ impl At<'_> {
     ) -> Result<Arrival> {
         let down = [
             fields.ordinary(q[0]),
-            fields.extraordinary(q[1], ek.map(|w| -w)),
+            fields.extraordinary(q[1], ek.map(|w| (true, -w))),
         ];
-        let fresnel = UniaxialFresnel::new(T::ONE * self.eta, w, [psi(&down[0]), psi(&down[1])])
+        let fresnel = UniaxialFresnel::new(T::one() * self.eta, w, [psi(&down[0]), psi(&down[1])])
             .ok_or_else(singular)?;
-        let zero = T::ZERO;
+        let zero = T::zero();
         match self.incident {
             Incident::Outside => {
                 // The incident s and p waves carry the same flux, ½ w.
@@ -169,7 +169,7 @@ impl At<'_> {
             }
             Incident::Inside(kind) => {
                 let (up, q_in) = match kind {
-                    ModeKind::E => (fields.extraordinary(q[3], ek), q[3]),
+                    ModeKind::E => (fields.extraordinary(q[3], ek.map(|w| (true, w))), q[3]),
                     _ => (fields.ordinary(q[2]), q[2]),
                 };
                 let p_in = incoming_power(up.flux.abs())?;
@@ -200,7 +200,7 @@ impl At<'_> {
     /// The exterior's outgoing s/p lobe with amplitudes `a[out][in]` to `sink`, if it carries
     /// power (not beyond the critical angle). Its s wave `E = ŷ`, `H = (−w, 0, β)` has flux
     /// `½ w`.
-    fn exterior<T: Scalar>(
+    fn exterior<T: Scalar<f64>>(
         &self,
         w: T,
         a: [[T; 2]; 2],
@@ -237,7 +237,7 @@ impl At<'_> {
     /// The outgoing crystal wave `kind` of normal component `q` and fields `wave`, with
     /// amplitudes `a` for the incoming `[s, p]` (from outside) or `[wave, —]` (from inside), to
     /// `sink` if it carries power (not evanescent).
-    fn crystal<T: Scalar>(
+    fn crystal<T: Scalar<f64>>(
         &self,
         kind: ModeKind,
         q: T,
@@ -267,7 +267,7 @@ impl At<'_> {
     }
 
     /// The ray of a crystal wave that carries power (its field is real).
-    fn ray<T: Scalar>(&self, q: T, wave: &Wave<T>) -> Ray {
+    fn ray<T: Scalar<f64>>(&self, q: T, wave: &Wave<T>) -> Ray {
         let re = |v: &[T; 3]| Vector3::new(v[0].re(), v[1].re(), v[2].re());
         let (e, h) = (re(&wave.e), re(&wave.h));
         let s = e.cross(&h);
@@ -302,12 +302,12 @@ struct Ray {
 
 /// The tangential fields of a wave.
 #[inline(always)]
-fn psi<T: Scalar>(wave: &Wave<T>) -> Psi<T> {
+fn psi<T: Scalar<f64>>(wave: &Wave<T>) -> Psi<T> {
     [wave.e[0], wave.e[1], wave.h[0], wave.h[1]]
 }
 
 /// The Hermitian norm of a 3-vector.
-fn size<T: Scalar>(v: &[T; 3]) -> f64 {
+fn size<T: Scalar<f64>>(v: &[T; 3]) -> f64 {
     (v[0].norm_sqr() + v[1].norm_sqr() + v[2].norm_sqr()).sqrt()
 }
 

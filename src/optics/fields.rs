@@ -9,37 +9,38 @@
 //! are degenerate and `ŷ` stands in for `k × A`; the two fields still span the transverse plane.
 
 use crate::cmath::Scalar;
+use crate::real::{Mask, Real};
 use nalgebra::Vector3;
 
 /// A 3-vector of the arithmetic `T`.
 pub type V3<T> = [T; 3];
 
-/// One mode's fields and normal Poynting flux `½ Re(E × H*)_z`.
+/// One mode's fields and normal Poynting flux `½ Re(E × H*)_z`, over the reals `R`.
 #[derive(Clone, Copy, Debug)]
-pub struct Wave<T> {
+pub struct Wave<T, R = f64> {
     /// Electric field, unit Hermitian norm.
     pub e: V3<T>,
     /// Magnetic field `k × E`.
     pub h: V3<T>,
     /// Normal Poynting flux of the unit-amplitude wave (positive upwards).
-    pub flux: f64,
+    pub flux: R,
 }
 
 /// What the o and e fields of one medium and incidence parameter share: the axis, `β`, and
 /// `ε`, `ε⁻¹` as scalars, so that `ε v` and `ε⁻¹ v` cost a dot product with the (real) axis.
-pub struct Fields<T> {
+pub struct Fields<T, R = f64> {
     beta: T,
-    axis: Vector3<f64>,
+    axis: Vector3<R>,
     eps_o: T,
     delta_eps: T,
     inv_o: T,
     delta_inv: T,
 }
 
-impl<T: Scalar> Fields<T> {
+impl<R: Real, T: Scalar<R>> Fields<T, R> {
     /// The fields of a medium with permittivities `eps_o`, `eps_e` and unit `axis` at `beta`.
     #[inline(always)]
-    pub fn new(eps_o: T, eps_e: T, axis: Vector3<f64>, beta: T) -> Self {
+    pub fn new(eps_o: T, eps_e: T, axis: Vector3<R>, beta: T) -> Self {
         let (inv_o, inv_e) = (eps_o.inverse(), eps_e.inverse());
         Fields {
             beta,
@@ -53,33 +54,40 @@ impl<T: Scalar> Fields<T> {
 
     /// The o-wave of normal component `q`.
     #[inline(always)]
-    pub fn ordinary(&self, q: T) -> Wave<T> {
+    pub fn ordinary(&self, q: T) -> Wave<T, R> {
         self.wave(q, normalize(self.ordinary_displacement(q)))
     }
 
-    /// The e-wave of normal component `q`. `ek_z = Some((εk)_z)` for a lossless propagating
-    /// wave (real `T`): its flux is then evaluated without cancellation. Its ray is `∝ ε k`
-    /// (eq. S12), so `S_z = (S·k) (εk)_z / (kᵀεk)` with `(εk)_z = a q + b = ±w` known
-    /// exactly from the root (near `K_max` the direct `½(E×H*)_z` loses digits).
+    /// The e-wave of normal component `q`. `ek_z = Some((exact, (εk)_z))` for a lossless medium
+    /// (real `β`): where `exact` holds (the wave propagates) its flux is evaluated without
+    /// cancellation. Its ray is `∝ ε k` (eq. S12), so `S_z = (S·k) (εk)_z / (kᵀεk)` with
+    /// `(εk)_z = a q + b = ±w` known exactly from the root (near `K_max` the direct
+    /// `½(E×H*)_z` loses digits).
     #[inline(always)]
-    pub fn extraordinary(&self, q: T, ek_z: Option<f64>) -> Wave<T> {
+    pub fn extraordinary(&self, q: T, ek_z: Option<(R::Mask, R)>) -> Wave<T, R> {
         let d = k_cross(self.beta, q, &self.ordinary_displacement(q));
         let mut wave = self.wave(q, normalize(self.inverse_permittivity_times(&d)));
-        if let Some(ek_z) = ek_z {
-            let (e, h) = (&wave.e, &wave.h);
-            // `S·k` with `k = (β, 0, q)` real: only `S_x` and `S_z` of `½ Re(E × H*)` count.
-            let s_x = 0.5 * (e[1] * h[2].conj() - e[2] * h[1].conj()).re();
-            let k_eps_k = self.k_eps_k(q).re();
-            wave.flux = (s_x * self.beta.re() + wave.flux * q.re()) * ek_z / k_eps_k;
+        if let Some((exact, ek_z)) = ek_z {
+            let direct = wave.flux;
+            wave.flux = exact.when(
+                || {
+                    let (e, h) = (&wave.e, &wave.h);
+                    // `S·k` with `k = (β, 0, q)` real: only `S_x` and `S_z` of `½ Re(E × H*)`.
+                    let s_x = (e[1] * h[2].conj() - e[2] * h[1].conj()).re() * 0.5;
+                    let k_eps_k = self.k_eps_k(q).re();
+                    (s_x * self.beta.re() + direct * q.re()) * ek_z / k_eps_k
+                },
+                || direct,
+            );
         }
         wave
     }
 
     /// The wave of normal component `q` and field `e`.
     #[inline(always)]
-    fn wave(&self, q: T, e: V3<T>) -> Wave<T> {
+    fn wave(&self, q: T, e: V3<T>) -> Wave<T, R> {
         let h = k_cross(self.beta, q, &e);
-        let flux = 0.5 * (e[0] * h[1].conj() - e[1] * h[0].conj()).re();
+        let flux = (e[0] * h[1].conj() - e[1] * h[0].conj()).re() * 0.5;
         Wave { e, h, flux }
     }
 
@@ -115,30 +123,29 @@ impl<T: Scalar> Fields<T> {
     fn ordinary_displacement(&self, q: T) -> V3<T> {
         let (beta, a) = (self.beta, &self.axis);
         let c = [-(q * a.y), q * a.x - beta * a.z, beta * a.y];
-        if size(&c) > 1e-24 * (beta.norm_sqr() + q.norm_sqr()) {
-            c
-        } else {
-            [T::ZERO, T::ONE, T::ZERO]
-        }
+        let tiny = (beta.norm_sqr() + q.norm_sqr()) * 1e-24;
+        size(&c)
+            .gt(tiny)
+            .when(|| c, || [T::zero(), T::one(), T::zero()])
     }
 }
 
 /// `k × v` for `k = (β, 0, q)` (eq. S2 for `v = E`), written out for the zero `k_y`.
 #[inline(always)]
-pub fn k_cross<T: Scalar>(beta: T, q: T, v: &V3<T>) -> V3<T> {
+pub fn k_cross<R: Real, T: Scalar<R>>(beta: T, q: T, v: &V3<T>) -> V3<T> {
     [-(q * v[1]), q * v[0] - beta * v[2], beta * v[1]]
 }
 
 /// `|v|²`, the squared Hermitian norm.
 #[inline(always)]
-fn size<T: Scalar>(v: &V3<T>) -> f64 {
+fn size<R: Real, T: Scalar<R>>(v: &V3<T>) -> R {
     v[0].norm_sqr() + v[1].norm_sqr() + v[2].norm_sqr()
 }
 
 /// `v / |v|` with the Hermitian norm.
 #[inline(always)]
-fn normalize<T: Scalar>(v: V3<T>) -> V3<T> {
-    let s = 1.0 / size(&v).sqrt();
+fn normalize<R: Real, T: Scalar<R>>(v: V3<T>) -> V3<T> {
+    let s = size(&v).sqrt().recip();
     [v[0] * s, v[1] * s, v[2] * s]
 }
 
@@ -162,7 +169,7 @@ mod tests {
             let (beta, q) = (next(), 2.0 * next() - 1.0);
             let real = Fields::new(eps_o, eps_e, axis, beta);
             let full = Fields::new(c(eps_o), c(eps_e), axis, c(beta));
-            let ek_z = Some(next());
+            let ek_z = Some((true, next()));
             let waves = [
                 (real.ordinary(q), full.ordinary(c(q))),
                 (real.extraordinary(q, ek_z), full.extraordinary(c(q), ek_z)),

@@ -15,32 +15,32 @@
 //! from below, swap 1 and 2 (a mirror through the surface maps the basis onto itself up to a
 //! sign common to incident and outgoing p waves).
 
-use crate::cmath;
+use crate::cmath::singular;
+use crate::error::Result;
+use crate::real::complex::{self as cx, Cx};
+use crate::real::{Mask, Real};
 use num_complex::Complex64 as C64;
 
 /// Amplitudes `[s, p]` of one isotropic/isotropic interface, both directions of incidence.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Fresnel {
+pub struct Fresnel<T: Real = f64> {
     /// Reflection of a wave arriving from above.
-    pub r_above: [C64; 2],
+    pub r_above: [Cx<T>; 2],
     /// Transmission of a wave arriving from above.
-    pub t_above: [C64; 2],
+    pub t_above: [Cx<T>; 2],
     /// Reflection of a wave arriving from below.
-    pub r_below: [C64; 2],
+    pub r_below: [Cx<T>; 2],
     /// Transmission of a wave arriving from below.
-    pub t_below: [C64; 2],
+    pub t_below: [Cx<T>; 2],
 }
 
 /// `w = sqrt(η² − β²)` on the branch of the up-going wave, evaluated as `(η − β)(η + β)` so
 /// that it stays exact near grazing and critical incidence.
-pub fn normal_component(eta: C64, beta: C64) -> C64 {
-    let w = cmath::sqrt((eta - beta) * (eta + beta));
+pub fn normal_component<T: Real>(eta: Cx<T>, beta: Cx<T>) -> Cx<T> {
+    let w = cx::sqrt((eta - beta) * (eta + beta));
     // Principal root: Re w ≥ 0; the up-going wave also needs Im w ≥ 0 when Re w = 0.
-    if w.re == 0.0 && w.im < 0.0 {
-        -w
-    } else {
-        w
-    }
+    let zero = T::zero();
+    (w.re.equals(zero) & w.im.lt(zero)).when(|| -w, || w)
 }
 
 impl Fresnel {
@@ -49,26 +49,41 @@ impl Fresnel {
     /// `w₁ + w₂ = 0` or the p pole), which a passive pair of media reaches only at grazing
     /// incidence from both sides at once.
     pub fn new(eta1: C64, eta2: C64, beta: C64) -> Option<Self> {
+        Self::amplitudes(eta1, eta2, beta).ok()
+    }
+}
+
+impl<T: Real> Fresnel<T> {
+    /// [`Fresnel::new`] over the reals `T`: the singular error where a denominator vanishes or
+    /// an amplitude is not finite (while recording, those lanes fail).
+    pub fn amplitudes(eta1: Cx<T>, eta2: Cx<T>, beta: Cx<T>) -> Result<Self> {
         let (w1, w2) = (normal_component(eta1, beta), normal_component(eta2, beta));
         let (e1, e2) = (eta1 * eta1, eta2 * eta2);
         let ds = w1 + w2;
         let dp = w1 * e2 + w2 * e1;
-        if ds == C64::new(0.0, 0.0) || dp == C64::new(0.0, 0.0) {
-            return None;
-        }
-        let (is, ip) = (ds.inv(), dp.inv());
-        let two = 2.0 * eta1 * eta2;
+        let zero = T::zero();
+        let vanishes = |d: Cx<T>| d.re.equals(zero) & d.im.equals(zero);
+        let pole = vanishes(ds) | vanishes(dp);
+        pole.fail(singular)?;
+        let one = Cx::new(T::one(), zero);
+        let (is, ip) = (
+            cx::inv(pole.when(|| one, || ds)),
+            cx::inv(pole.when(|| one, || dp)),
+        );
+        let two = T::cst(2.0);
+        let two_eta = eta1 * eta2 * two;
         let f = Fresnel {
             r_above: [(w1 - w2) * is, (w1 * e2 - w2 * e1) * ip],
-            t_above: [2.0 * w1 * is, two * w1 * ip],
+            t_above: [w1 * is * two, two_eta * w1 * ip],
             r_below: [(w2 - w1) * is, (w2 * e1 - w1 * e2) * ip],
-            t_below: [2.0 * w2 * is, two * w2 * ip],
+            t_below: [w2 * is * two, two_eta * w2 * ip],
         };
-        let finite = |a: &[C64; 2]| a.iter().all(|z| z.re.is_finite() && z.im.is_finite());
-        [f.r_above, f.t_above, f.r_below, f.t_below]
+        let finite = [f.r_above, f.t_above, f.r_below, f.t_below]
             .iter()
-            .all(finite)
-            .then_some(f)
+            .flatten()
+            .fold(T::Mask::cst(true), |m, z| m & z.re.finite() & z.im.finite());
+        (!finite).fail(singular)?;
+        Ok(f)
     }
 }
 

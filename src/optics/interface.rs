@@ -10,45 +10,46 @@
 //! covers iso→aniso, aniso→iso and aniso→aniso interfaces alike; when one side is isotropic,
 //! [`Interface::solve`] reduces it to a 2x2 solve ([`crate::optics::admittance`]) with the same `S`.
 
-use crate::cmath;
-use crate::error::{Error, Result};
+use crate::cmath::{self, singular};
+use crate::error::Result;
 use crate::optics::admittance;
 use crate::optics::fresnel::Fresnel;
 use crate::optics::medium::Uniaxial;
 use crate::optics::modes::{modes, Mode, ModeKind, ModeSet};
+use crate::real::complex::{self as cx, Cx};
+use crate::real::{Mask, Real};
 use nalgebra::{Matrix2, Matrix4};
-use num_complex::Complex64 as C64;
 
 /// The solved interface for one incidence parameter.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Interface {
+pub struct Interface<T: Real = f64> {
     /// Modes of the upper medium.
-    pub upper: ModeSet,
+    pub upper: ModeSet<T>,
     /// Modes of the lower medium.
-    pub lower: ModeSet,
+    pub lower: ModeSet<T>,
     /// Scattering matrix: rows `[up₁ (2); down₂ (2)]`, columns `[down₁ (2); up₂ (2)]`.
-    pub s: Matrix4<C64>,
+    pub s: Matrix4<Cx<T>>,
 }
 
 /// Writes `sign ×` the tangential fields of two modes into columns `offset`, `offset + 1`.
-fn put(m: &mut Matrix4<C64>, offset: usize, pair: &[Mode; 2], sign: f64) {
+fn put<T: Real>(m: &mut Matrix4<Cx<T>>, offset: usize, pair: &[Mode<T>; 2], sign: f64) {
     for (j, mode) in pair.iter().enumerate() {
         for (i, f) in mode.tangential().iter().enumerate() {
-            m[(i, offset + j)] = f * sign;
+            m[(i, offset + j)] = *f * T::cst(sign);
         }
     }
 }
 
-impl Interface {
+impl<T: Real> Interface<T> {
     /// Solves the interface between `upper` and `lower` (axes in the working frame) for the
     /// incidence parameter `beta`.
     /// Two isotropic media take the closed-form Fresnel amplitudes ([`Fresnel`]; the same
     /// matrix as the 4x4 solve, which `tests/interface_physics.rs` checks).
     #[inline]
-    pub fn new(upper: &Uniaxial, lower: &Uniaxial, beta: C64) -> Result<Self> {
-        if upper.is_isotropic() && lower.is_isotropic() {
+    pub fn new(upper: &Uniaxial<T>, lower: &Uniaxial<T>, beta: Cx<T>) -> Result<Self> {
+        if (upper.is_isotropic() & lower.is_isotropic()).surely() {
             let (m1, m2) = (modes(upper, beta), modes(lower, beta));
-            let f = Fresnel::new(upper.eta_o, lower.eta_o, beta).ok_or_else(singular)?;
+            let f = Fresnel::amplitudes(upper.eta_o, lower.eta_o, beta)?;
             return Ok(Self::isotropic(m1, m2, &f));
         }
         // Solved in place: an `Interface` is large, moving it costs.
@@ -62,7 +63,7 @@ impl Interface {
     /// isotropic medium), else by the general 4x4 solve ([`Interface::from_modes`]). The same
     /// scattering matrix either way, to rounding (`tests/interface_fast_path.rs`).
     #[inline]
-    pub fn solve(upper: ModeSet, lower: ModeSet) -> Result<Self> {
+    pub fn solve(upper: ModeSet<T>, lower: ModeSet<T>) -> Result<Self> {
         let mut out = Self::unsolved(upper, lower);
         out.solve_in_place()?;
         Ok(out)
@@ -70,11 +71,11 @@ impl Interface {
 
     /// The two mode sets with `S = 0`, for [`Interface::solve_in_place`].
     #[inline]
-    pub(crate) fn unsolved(upper: ModeSet, lower: ModeSet) -> Self {
+    pub(crate) fn unsolved(upper: ModeSet<T>, lower: ModeSet<T>) -> Self {
         Interface {
             upper,
             lower,
-            s: Matrix4::zeros(),
+            s: Matrix4::from_element(cx::real(T::zero())),
         }
     }
 
@@ -97,13 +98,13 @@ impl Interface {
             self.s = from_modes_s(upper, lower)?;
             return Ok(());
         };
-        place(&mut self.s, &solution.ok_or_else(singular)?, iso_above)
+        place(&mut self.s, &solution?, iso_above)
     }
 
     /// The interface of two isotropic media from its Fresnel amplitudes: every block of `S`
     /// is diagonal in the s/p bases.
-    fn isotropic(upper: ModeSet, lower: ModeSet, f: &Fresnel) -> Self {
-        let mut s = Matrix4::zeros();
+    fn isotropic(upper: ModeSet<T>, lower: ModeSet<T>, f: &Fresnel<T>) -> Self {
+        let mut s = Matrix4::from_element(cx::real(T::zero()));
         for k in 0..2 {
             s[(k, k)] = f.r_above[k];
             s[(2 + k, k)] = f.t_above[k];
@@ -114,28 +115,28 @@ impl Interface {
     }
 
     /// Solves the boundary system for given mode sets (eq. S18).
-    pub fn from_modes(upper: ModeSet, lower: ModeSet) -> Result<Self> {
+    pub fn from_modes(upper: ModeSet<T>, lower: ModeSet<T>) -> Result<Self> {
         let s = from_modes_s(&upper, &lower)?;
         Ok(Interface { upper, lower, s })
     }
 
     /// Reflection of waves arriving from above: `up₁ ← down₁` (rows/cols in mode order).
-    pub fn r_above(&self) -> Matrix2<C64> {
+    pub fn r_above(&self) -> Matrix2<Cx<T>> {
         self.s.fixed_view::<2, 2>(0, 0).into_owned()
     }
 
     /// Transmission of waves arriving from above: `down₂ ← down₁`.
-    pub fn t_above(&self) -> Matrix2<C64> {
+    pub fn t_above(&self) -> Matrix2<Cx<T>> {
         self.s.fixed_view::<2, 2>(2, 0).into_owned()
     }
 
     /// Transmission of waves arriving from below: `up₁ ← up₂`.
-    pub fn t_below(&self) -> Matrix2<C64> {
+    pub fn t_below(&self) -> Matrix2<Cx<T>> {
         self.s.fixed_view::<2, 2>(0, 2).into_owned()
     }
 
     /// Reflection of waves arriving from below: `down₂ ← up₂`.
-    pub fn r_below(&self) -> Matrix2<C64> {
+    pub fn r_below(&self) -> Matrix2<Cx<T>> {
         self.s.fixed_view::<2, 2>(2, 2).into_owned()
     }
 
@@ -143,57 +144,66 @@ impl Interface {
     /// carried by outgoing wave `i` per unit flux of incoming wave `j`, each wave's own normal
     /// Poynting flux (`|S_ij|² |P_i| / |P_j|`). Evanescent waves in lossless media carry none.
     /// Columns of incoming waves that carry no flux are zero.
-    pub fn power(&self) -> Matrix4<f64> {
+    pub fn power(&self) -> Matrix4<T> {
         let out = self.outgoing_flux();
         let inc = self.incoming_flux();
+        let zero = T::zero();
         Matrix4::from_fn(|i, j| {
-            if inc[j] > 0.0 {
-                self.s[(i, j)].norm_sqr() * out[i] / inc[j]
-            } else {
-                0.0
-            }
+            let carries = inc[j].gt(zero);
+            let safe = carries.when(|| inc[j], T::one);
+            carries.when(|| cx::norm_sqr(self.s[(i, j)]) * out[i] / safe, || zero)
         })
     }
 
     /// `|P|` of the outgoing waves `[up₁, down₂]` (0 for an evanescent wave).
-    pub fn outgoing_flux(&self) -> [f64; 4] {
+    pub fn outgoing_flux(&self) -> [T; 4] {
         let (u, d) = (&self.upper.up, &self.lower.down);
         [&u[0], &u[1], &d[0], &d[1]].map(carried)
     }
 
     /// `|P|` of the incoming waves `[down₁, up₂]` (0 for an evanescent wave: its flux is
     /// rounding noise, and dividing by it would give meaningless power ratios).
-    pub fn incoming_flux(&self) -> [f64; 4] {
+    pub fn incoming_flux(&self) -> [T; 4] {
         let (d, u) = (&self.upper.down, &self.lower.up);
         [&d[0], &d[1], &u[0], &u[1]].map(carried)
     }
 }
 
 /// `S` by the general 4x4 solve of [`Interface::from_modes`].
-fn from_modes_s(upper: &ModeSet, lower: &ModeSet) -> Result<Matrix4<C64>> {
-    let mut lhs = Matrix4::zeros();
-    let mut rhs = Matrix4::zeros();
+fn from_modes_s<T: Real>(upper: &ModeSet<T>, lower: &ModeSet<T>) -> Result<Matrix4<Cx<T>>> {
+    let zero = Matrix4::from_element(cx::real(T::zero()));
+    let (mut lhs, mut rhs) = (zero, zero);
     put(&mut lhs, 0, &upper.up, 1.0);
     put(&mut lhs, 2, &lower.down, -1.0);
     put(&mut rhs, 0, &upper.down, -1.0);
     put(&mut rhs, 2, &lower.up, 1.0);
-    let s = cmath::solve4(&lhs, &rhs).ok_or_else(singular)?;
-    if s.iter().any(|z| !z.re.is_finite() || !z.im.is_finite()) {
-        return Err(singular());
-    }
+    let real_system = lhs
+        .iter()
+        .chain(rhs.iter())
+        .fold(T::Mask::cst(true), |m, z| m & z.im.equals(T::zero()));
+    let s = if real_system.surely() {
+        let x = cmath::eliminate4(&lhs.map(|z| z.re), &[rhs.map(|z| z.re)])?;
+        x[0].map(cx::real)
+    } else {
+        cmath::eliminate4(&lhs, &[rhs])?[0]
+    };
+    let finite = s
+        .iter()
+        .fold(T::Mask::cst(true), |m, z| m & z.re.finite() & z.im.finite());
+    (!finite).fail(singular)?;
     Ok(s)
 }
 
 /// True for the s/p pair of an isotropic medium ([`crate::optics::modes::isotropic_modes`]): the s
 /// mode has only `(E_y, H_x)`, the p mode only `(E_x, H_y)`, which the admittance reduction needs.
-fn is_sp(m: &ModeSet) -> bool {
-    let sp = |p: &[Mode; 2]| p[0].kind == ModeKind::S && p[1].kind == ModeKind::P;
+fn is_sp<T: Real>(m: &ModeSet<T>) -> bool {
+    let sp = |p: &[Mode<T>; 2]| p[0].kind == ModeKind::S && p[1].kind == ModeKind::P;
     sp(&m.down) && sp(&m.up)
 }
 
 /// The tangential fields `ψ` of a pair of modes.
 #[inline]
-fn tangential(pair: &[Mode; 2]) -> [[C64; 4]; 2] {
+fn tangential<T: Real>(pair: &[Mode<T>; 2]) -> [[Cx<T>; 4]; 2] {
     [pair[0].tangential(), pair[1].tangential()]
 }
 
@@ -202,16 +212,17 @@ fn tangential(pair: &[Mode; 2]) -> [[C64; 4]; 2] {
 /// isotropic and the other medium's blocks swapped in rows and columns for an isotropic lower
 /// one. The singular error if any entry is not finite (as [`Interface::from_modes`]).
 #[inline]
-fn place(s: &mut Matrix4<C64>, r: &admittance::Solution, iso_above: bool) -> Result<()> {
-    // `0·x` is 0 for a finite `x` and NaN otherwise; the sum keeps a NaN.
-    let nan = |m: &[[C64; 4]; 2]| {
-        m.iter()
+fn place<T: Real>(
+    s: &mut Matrix4<Cx<T>>,
+    r: &admittance::Solution<Cx<T>>,
+    iso_above: bool,
+) -> Result<()> {
+    let finite =
+        r.x.iter()
+            .chain(&r.y)
             .flatten()
-            .fold(0.0, |acc, z| acc + (z.re * 0.0 + z.im * 0.0))
-    };
-    if nan(&r.x) + nan(&r.y) != 0.0 {
-        return Err(singular());
-    }
+            .fold(T::Mask::cst(true), |m, z| m & z.re.finite() & z.im.finite());
+    (!finite).fail(singular)?;
     let (first, second, shift) = if iso_above {
         (&r.x, &r.y, 0)
     } else {
@@ -227,18 +238,6 @@ fn place(s: &mut Matrix4<C64>, r: &admittance::Solution, iso_above: bool) -> Res
 }
 
 /// The power a mode carries through the surface: `|P|`, or 0 if it is evanescent.
-fn carried(m: &Mode) -> f64 {
-    if m.is_evanescent() {
-        0.0
-    } else {
-        m.flux().abs()
-    }
-}
-
-/// The error of a singular boundary system.
-pub(crate) fn singular() -> Error {
-    Error::new(
-        "interface",
-        "the boundary system is singular for this incidence (a guided or degenerate mode)",
-    )
+fn carried<T: Real>(m: &Mode<T>) -> T {
+    m.is_evanescent().when(T::zero, || m.flux().abs())
 }

@@ -6,23 +6,26 @@
 
 use crate::error::{finite, Error, Result};
 use crate::material::check_index;
+use crate::real::complex::Cx;
+use crate::real::Real;
 use nalgebra::{Matrix3, Vector3};
 use num_complex::Complex64 as C64;
 
 /// A homogeneous, non-magnetic uniaxial medium: permittivity
-/// `ε = ε_o I + (ε_e − ε_o) A Aᵀ` (eq. S6) with `ε_o = η_o²`, `ε_e = η_e²`.
+/// `ε = ε_o I + (ε_e − ε_o) A Aᵀ` (eq. S6) with `ε_o = η_o²`, `ε_e = η_e²`; in the numbers `T`
+/// of [`crate::real`] (`f64` on the host).
 ///
 /// Dichroism (eq. S16) is carried by separate extinction coefficients in `η_o` and `η_e`:
 /// light polarised perpendicular to `A` sees `κ_o`, light polarised along `A` sees `κ_e`.
 /// `η_o == η_e` (bit for bit) makes the medium isotropic, and the core then uses s/p modes.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Uniaxial {
+pub struct Uniaxial<T: Real = f64> {
     /// Ordinary complex index `n_o + iκ_o`.
-    pub eta_o: C64,
+    pub eta_o: Cx<T>,
     /// Extraordinary complex index `n_e + iκ_e`.
-    pub eta_e: C64,
+    pub eta_e: Cx<T>,
     /// Unit optic axis, in whatever frame the caller works in.
-    pub axis: Vector3<f64>,
+    pub axis: Vector3<T>,
 }
 
 impl Uniaxial {
@@ -57,31 +60,6 @@ impl Uniaxial {
         })
     }
 
-    /// True when the two indices are identical: the medium is then isotropic.
-    pub fn is_isotropic(&self) -> bool {
-        self.eta_o == self.eta_e
-    }
-
-    /// True when both indices are real (no absorption).
-    pub fn is_lossless(&self) -> bool {
-        self.eta_o.im == 0.0 && self.eta_e.im == 0.0
-    }
-
-    /// Ordinary permittivity `ε_o = η_o²`.
-    pub fn eps_o(&self) -> C64 {
-        self.eta_o * self.eta_o
-    }
-
-    /// Extraordinary permittivity `ε_e = η_e²`.
-    pub fn eps_e(&self) -> C64 {
-        self.eta_e * self.eta_e
-    }
-
-    /// The same medium with `axis` (a unit vector, e.g. the axis seen from another frame).
-    pub fn with_axis(&self, axis: Vector3<f64>) -> Self {
-        Uniaxial { axis, ..*self }
-    }
-
     /// The permittivity tensor `ε_o I + Δε A Aᵀ` (eq. S6).
     pub fn permittivity(&self) -> Matrix3<C64> {
         let a = self.axis.map(|x| C64::new(x, 0.0));
@@ -93,6 +71,45 @@ impl Uniaxial {
         let a = self.axis.map(|x| C64::new(x, 0.0));
         let (io, ie) = (self.eps_o().inv(), self.eps_e().inv());
         Matrix3::identity() * io + a * a.transpose() * (ie - io)
+    }
+}
+
+impl<T: Real> Uniaxial<T> {
+    /// An isotropic medium of the (unchecked) index `eta`, axis +z: the exterior and exit
+    /// media of a query.
+    pub fn isotropic_unchecked(eta: Cx<T>) -> Self {
+        let (zero, one) = (T::zero(), T::one());
+        Uniaxial {
+            eta_o: eta,
+            eta_e: eta,
+            axis: Vector3::new(zero, zero, one),
+        }
+    }
+
+    /// True when the two indices are identical: the medium is then isotropic.
+    pub fn is_isotropic(&self) -> T::Mask {
+        self.eta_o.re.equals(self.eta_e.re) & self.eta_o.im.equals(self.eta_e.im)
+    }
+
+    /// True when both indices are real (no absorption).
+    pub fn is_lossless(&self) -> T::Mask {
+        let zero = T::zero();
+        self.eta_o.im.equals(zero) & self.eta_e.im.equals(zero)
+    }
+
+    /// Ordinary permittivity `ε_o = η_o²`.
+    pub fn eps_o(&self) -> Cx<T> {
+        self.eta_o * self.eta_o
+    }
+
+    /// Extraordinary permittivity `ε_e = η_e²`.
+    pub fn eps_e(&self) -> Cx<T> {
+        self.eta_e * self.eta_e
+    }
+
+    /// The same medium with `axis` (a unit vector, e.g. the axis seen from another frame).
+    pub fn with_axis(&self, axis: Vector3<T>) -> Self {
+        Uniaxial { axis, ..*self }
     }
 }
 

@@ -10,11 +10,13 @@
 use crate::cmath::{self, Scalar};
 use crate::optics::fields::{Fields, Wave};
 use crate::optics::medium::Uniaxial;
+use crate::real::complex::{self as cx, Cx};
+use crate::real::{Mask, Real};
 use nalgebra::Vector3;
 use num_complex::Complex64 as C64;
 
 /// A complex 3-vector.
-pub type C3 = Vector3<C64>;
+pub type C3<T = f64> = Vector3<Cx<T>>;
 
 /// Which polarisation family a mode belongs to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -37,44 +39,60 @@ pub enum ModeKind {
 /// too); o/e modes of anisotropic media have unit Hermitian norm `|E| = 1` with the phase of
 /// the closed-form construction of [`crate::optics::fields`] (real for real wave vectors).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Mode {
+pub struct Mode<T: Real = f64> {
     /// Polarisation family.
     pub kind: ModeKind,
     /// Tangential wave-vector component `β = K/k0` (eq. S1).
-    pub beta: C64,
+    pub beta: Cx<T>,
     /// Normal wave-vector component `q/k0` (eq. S9).
-    pub q: C64,
+    pub q: Cx<T>,
     /// Electric field (eq. S10).
-    pub e: C3,
+    pub e: C3<T>,
     /// Magnetic field `k × E` (eq. S2).
-    pub h: C3,
+    pub h: C3<T>,
     /// Normal Poynting flux `½ Re(E × H*)_z` of the unit-amplitude mode (positive upwards).
-    pub flux: f64,
+    pub flux: T,
 }
 
-impl Mode {
+impl<T: Real> Mode<T> {
     /// The wave vector `(β, 0, q)` in units of `k0`.
-    pub fn wave_vector(&self) -> C3 {
+    pub fn wave_vector(&self) -> C3<T> {
         wave_vector(self.beta, self.q)
     }
 
     /// The tangential field components `(E_x, E_y, H_x, H_y)` matched at a boundary (eq. S18).
-    pub fn tangential(&self) -> [C64; 4] {
+    pub fn tangential(&self) -> [Cx<T>; 4] {
         [self.e.x, self.e.y, self.h.x, self.h.y]
     }
 
     /// Time-averaged Poynting vector `½ Re(E × H*)` of the unit-amplitude mode at the surface.
-    pub fn poynting(&self) -> Vector3<f64> {
+    pub fn poynting(&self) -> Vector3<T> {
         let hc = self.h.map(|c| c.conj());
-        self.e.cross(&hc).map(|c| 0.5 * c.re)
+        let c = self.e.cross(&hc);
+        Vector3::new(c.x.re * 0.5, c.y.re * 0.5, c.z.re * 0.5)
     }
 
     /// Normal component of the Poynting vector: the power this mode carries through the surface
     /// per unit area (positive upwards).
-    pub fn flux(&self) -> f64 {
+    pub fn flux(&self) -> T {
         self.flux
     }
 
+    /// True for a wave that carries (numerically) no power through the surface although its
+    /// field does not vanish: an evanescent wave past `K_max` (eq. S15) in a lossless medium.
+    /// (An e-wave past `K_max` keeps a real part of `q`; only its flux tells.)
+    pub fn is_evanescent(&self) -> T::Mask {
+        let scale = norm(&self.e) * norm(&self.h);
+        self.flux().abs().le(scale * 1e-12)
+    }
+}
+
+/// The Hermitian norm of a complex 3-vector.
+fn norm<T: Real>(v: &C3<T>) -> T {
+    (cx::norm_sqr(v.x) + cx::norm_sqr(v.y) + cx::norm_sqr(v.z)).sqrt()
+}
+
+impl Mode {
     /// Unit ray (Poynting) direction (eq. S12); `None` if the mode carries no power.
     pub fn ray_direction(&self) -> Option<Vector3<f64>> {
         let s = self.poynting();
@@ -104,36 +122,29 @@ impl Mode {
         let ray = self.ray_direction()?;
         Some(self.effective_index().re * self.wave_direction().dot(&ray))
     }
-
-    /// True for a wave that carries (numerically) no power through the surface although its
-    /// field does not vanish: an evanescent wave past `K_max` (eq. S15) in a lossless medium.
-    /// (An e-wave past `K_max` keeps a real part of `q`; only its flux tells.)
-    pub fn is_evanescent(&self) -> bool {
-        let scale = self.e.norm() * self.h.norm();
-        self.flux().abs() <= 1e-12 * scale
-    }
 }
 
 /// The four modes of a medium: two travelling/decaying downwards (`-z`), two upwards.
 /// Order within each pair: `[o, e]` for anisotropic media, `[s, p]` for isotropic ones.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ModeSet {
+pub struct ModeSet<T: Real = f64> {
     /// Modes carrying power (or decaying) towards `-z`.
-    pub down: [Mode; 2],
+    pub down: [Mode<T>; 2],
     /// Modes carrying power (or decaying) towards `+z`.
-    pub up: [Mode; 2],
+    pub up: [Mode<T>; 2],
 }
 
 /// `(β, 0, q)`.
-pub fn wave_vector(beta: C64, q: C64) -> C3 {
-    Vector3::new(beta, C64::new(0.0, 0.0), q)
+pub fn wave_vector<T: Real>(beta: Cx<T>, q: Cx<T>) -> C3<T> {
+    Vector3::new(beta, Cx::new(T::zero(), T::zero()), q)
 }
 
 /// The normal modes of `medium` (its axis given in the working frame) for incidence parameter
-/// `beta` (eqs. S9-S10). Isotropic media get s/p modes.
+/// `beta` (eqs. S9-S10). Isotropic media get s/p modes (where that is known while recording:
+/// else the uniaxial modes, which hold for equal indices too).
 #[inline(always)]
-pub fn modes(medium: &Uniaxial, beta: C64) -> ModeSet {
-    if medium.is_isotropic() {
+pub fn modes<T: Real>(medium: &Uniaxial<T>, beta: Cx<T>) -> ModeSet<T> {
+    if medium.is_isotropic().surely() {
         isotropic_modes(medium.eta_o, beta)
     } else {
         uniaxial_modes(medium, beta)
@@ -143,9 +154,9 @@ pub fn modes(medium: &Uniaxial, beta: C64) -> ModeSet {
 /// The normal components `q/k0` of the four modes, `[o↓, e↓, o↑, e↑]` (`[s, p, s, p]` for an
 /// isotropic medium), without the fields: the same roots and branches as [`modes`], at a
 /// fraction of its cost (for the phases of a layer whose amplitudes are known).
-pub fn normal_components(medium: &Uniaxial, beta: C64) -> [C64; 4] {
-    if medium.is_isotropic() {
-        let (qo_up, qo_down) = up_down(cmath::sqrt(normal_squared(medium.eta_o, beta)));
+pub fn normal_components<T: Real>(medium: &Uniaxial<T>, beta: Cx<T>) -> [Cx<T>; 4] {
+    if medium.is_isotropic().surely() {
+        let (qo_up, qo_down) = up_down(cx::sqrt(normal_squared(medium.eta_o, beta)));
         return [qo_down, qo_down, qo_up, qo_up];
     }
     uniaxial_normals(medium, beta).0
@@ -155,8 +166,8 @@ pub fn normal_components(medium: &Uniaxial, beta: C64) -> [C64; 4] {
 /// [`uniaxial_modes`] takes them, and the up-going e-wave's `w = a q⁺ + b = (εk)_z` (real
 /// when the e-wave propagates in a lossless medium: its exact flux, [`Fields::extraordinary`]).
 #[inline]
-pub(crate) fn uniaxial_normals(medium: &Uniaxial, beta: C64) -> ([C64; 4], C64) {
-    let (qo_up, qo_down) = up_down(cmath::sqrt(normal_squared(medium.eta_o, beta)));
+pub(crate) fn uniaxial_normals<T: Real>(medium: &Uniaxial<T>, beta: Cx<T>) -> ([Cx<T>; 4], Cx<T>) {
+    let (qo_up, qo_down) = up_down(cx::sqrt(normal_squared(medium.eta_o, beta)));
     let (qe_up, qe_down, w) = extraordinary_q_w(medium, beta);
     ([qo_down, qe_down, qo_up, qe_up], w)
 }
@@ -169,31 +180,30 @@ pub(crate) fn uniaxial_normals(medium: &Uniaxial, beta: C64) -> ([C64; 4], C64) 
 /// waves is the sign of `Re(w/a)` (the e-wave ray is `∝ ε k`, whose normal part is `a q + b`).
 /// For passive media both criteria agree wherever both apply.
 #[inline]
-fn up_down_w(a: C64, b: C64, w: C64) -> (C64, C64, C64) {
-    let inv_a = cmath::inv(a);
-    let w = if goes_down(w * inv_a) { -w } else { w };
+fn up_down_w<T: Real>(a: Cx<T>, b: Cx<T>, w: Cx<T>) -> (Cx<T>, Cx<T>, Cx<T>) {
+    let inv_a = cx::inv(a);
+    let w = goes_down(w * inv_a).when(|| -w, || w);
     ((w - b) * inv_a, (-w - b) * inv_a, w)
 }
 
 /// [`up_down_w`] for `a = 1`, `b = 0` (o, s and p waves: `q = ±w`), `(q⁺, q⁻)`.
 #[inline]
-fn up_down(w: C64) -> (C64, C64) {
-    let w = if goes_down(w) { -w } else { w };
+fn up_down<T: Real>(w: Cx<T>) -> (Cx<T>, Cx<T>) {
+    let w = goes_down(w).when(|| -w, || w);
     (w, -w)
 }
 
 /// True if the root `q = u` of `q = ±u` is the down-going one (criterion of [`up_down_w`]).
 #[inline]
-fn goes_down(u: C64) -> bool {
-    if u.im.abs() > 1e-9 * u.re.abs() {
-        u.im < 0.0
-    } else {
-        u.re < 0.0
-    }
+fn goes_down<T: Real>(u: Cx<T>) -> T::Mask {
+    let zero = T::zero();
+    u.im.abs()
+        .gt(u.re.abs() * 1e-9)
+        .when(|| u.im.lt(zero), || u.re.lt(zero))
 }
 
 /// `η² − β²` evaluated as `(η − β)(η + β)`, exact near grazing/critical incidence.
-fn normal_squared(eta: C64, beta: C64) -> C64 {
+fn normal_squared<T: Real>(eta: Cx<T>, beta: Cx<T>) -> Cx<T> {
     (eta - beta) * (eta + beta)
 }
 
@@ -201,11 +211,12 @@ fn normal_squared(eta: C64, beta: C64) -> C64 {
 /// `E_p = k̂ × ŷ = (−q, 0, β)/η`, `H_p = k × E_p = (0, −(q² + β²)/η, 0)` (written out: the zero
 /// components are exact), fluxes `½ Re(E_x H_y* − E_y H_x*)`.
 #[inline(always)]
-pub fn isotropic_modes(eta: C64, beta: C64) -> ModeSet {
-    let zero = C64::new(0.0, 0.0);
-    let (q_up, q_down) = up_down(cmath::sqrt(normal_squared(eta, beta)));
-    let inv_eta = cmath::inv(eta);
-    let pair = |q: C64| {
+pub fn isotropic_modes<T: Real>(eta: Cx<T>, beta: Cx<T>) -> ModeSet<T> {
+    let zero = Cx::new(T::zero(), T::zero());
+    let one = Cx::new(T::one(), T::zero());
+    let (q_up, q_down) = up_down(cx::sqrt(normal_squared(eta, beta)));
+    let inv_eta = cx::inv(eta);
+    let pair = |q: Cx<T>| {
         let (ex, ez) = (-q * inv_eta, beta * inv_eta);
         let hy = q * ex - beta * ez;
         [
@@ -213,9 +224,9 @@ pub fn isotropic_modes(eta: C64, beta: C64) -> ModeSet {
                 kind: ModeKind::S,
                 beta,
                 q,
-                e: Vector3::new(zero, C64::new(1.0, 0.0), zero),
+                e: Vector3::new(zero, one, zero),
                 h: Vector3::new(-q, zero, beta),
-                flux: 0.5 * q.re,
+                flux: q.re * 0.5,
             },
             Mode {
                 kind: ModeKind::P,
@@ -223,7 +234,7 @@ pub fn isotropic_modes(eta: C64, beta: C64) -> ModeSet {
                 q,
                 e: Vector3::new(ex, zero, ez),
                 h: Vector3::new(zero, hy, zero),
-                flux: 0.5 * (ex * hy.conj()).re,
+                flux: (ex * hy.conj()).re * 0.5,
             },
         ]
     };
@@ -237,40 +248,48 @@ pub fn isotropic_modes(eta: C64, beta: C64) -> ModeSet {
 ///
 /// From `kᵀ ε k = ε_o ε_e` with `k = (β, 0, q)`: `a q² + 2 b q + c = 0`, `a = ε_o + Δε A_z²`,
 /// `b = Δε β A_x A_z`, discriminant `ε_o [ε_e a − β² (ε_e − Δε A_y²)]`.
-pub fn extraordinary_q(medium: &Uniaxial, beta: C64) -> (C64, C64) {
+pub fn extraordinary_q<T: Real>(medium: &Uniaxial<T>, beta: Cx<T>) -> (Cx<T>, Cx<T>) {
     let (up, down, _) = extraordinary_q_w(medium, beta);
     (up, down)
+}
+
+/// True where the medium is lossless and `β` real (known while recording when the indices
+/// are constants): the e-wave's coefficients are then real.
+fn real_coefficients<T: Real>(medium: &Uniaxial<T>, beta: Cx<T>) -> T::Mask {
+    medium.is_lossless() & beta.im.equals(T::zero())
 }
 
 /// [`extraordinary_q`] and the up-going `w = a q⁺ + b`. A lossless medium at real `β` has
 /// real coefficients, and real roots unless the e-wave is evanescent: then the same steps run
 /// in real arithmetic (what the complex ones reduce to).
 #[inline]
-fn extraordinary_q_w(medium: &Uniaxial, beta: C64) -> (C64, C64, C64) {
-    if medium.is_lossless() && beta.im == 0.0 {
+fn extraordinary_q_w<T: Real>(medium: &Uniaxial<T>, beta: Cx<T>) -> (Cx<T>, Cx<T>, Cx<T>) {
+    if real_coefficients(medium, beta).surely() {
         let (eps_o, eps_e) = (medium.eps_o().re, medium.eps_e().re);
         let (a, b, disc) = extraordinary_coefficients(eps_o, eps_e, &medium.axis, beta.re);
-        let c = |x: f64| C64::new(x, 0.0);
-        if disc >= 0.0 {
-            let w = disc.sqrt();
-            let inv_a = a.inverse();
-            let w = if w * inv_a < 0.0 { -w } else { w };
-            return (c((w - b) * inv_a), c((-w - b) * inv_a), c(w));
-        }
-        return up_down_w(c(a), c(b), cmath::sqrt(c(disc)));
+        let c = |x: T| cx::real(x);
+        return disc.ge(T::zero()).when(
+            || {
+                let w = disc.sqrt();
+                let inv_a = Scalar::inverse(a);
+                let w = (w * inv_a).lt(T::zero()).when(|| -w, || w);
+                (c((w - b) * inv_a), c((-w - b) * inv_a), c(w))
+            },
+            || up_down_w(c(a), c(b), cx::sqrt(c(disc))),
+        );
     }
     let (a, b, disc) =
         extraordinary_coefficients(medium.eps_o(), medium.eps_e(), &medium.axis, beta);
-    up_down_w(a, b, cmath::sqrt(disc))
+    up_down_w(a, b, cx::sqrt(disc))
 }
 
 /// `(a, b, disc)` of [`extraordinary_q`]: `a q² + 2 b q + c = 0` with the discriminant
 /// `b² − a c = ε_o [ε_e a − β² (ε_e − Δε A_y²)]`.
 #[inline(always)]
-fn extraordinary_coefficients<T: Scalar>(
+fn extraordinary_coefficients<R: Real, T: Scalar<R>>(
     eps_o: T,
     eps_e: T,
-    axis: &Vector3<f64>,
+    axis: &Vector3<R>,
     beta: T,
 ) -> (T, T, T) {
     let d = eps_e - eps_o;
@@ -297,14 +316,21 @@ pub fn k_max(medium: &Uniaxial) -> (C64, C64) {
 /// [`crate::optics::fields`]: in real arithmetic when every wave vector and field is real (lossless
 /// medium, real `β`, both waves propagating), else in complex arithmetic.
 #[inline(always)]
-pub fn uniaxial_modes(medium: &Uniaxial, beta: C64) -> ModeSet {
+pub fn uniaxial_modes<T: Real>(medium: &Uniaxial<T>, beta: Cx<T>) -> ModeSet<T> {
     let qo_squared = normal_squared(medium.eta_o, beta);
-    let (qo_up, qo_down) = up_down(cmath::sqrt(qo_squared));
+    let (qo_up, qo_down) = up_down(cx::sqrt(qo_squared));
     let (qe_up, qe_down, w) = extraordinary_q_w(medium, beta);
-    let exact_flux = medium.is_lossless() && beta.im == 0.0 && w.im == 0.0;
     let q = [qo_down, qe_down, qo_up, qe_up];
-    let ek_z = exact_flux.then_some(w.re);
-    if exact_flux && qo_squared.im == 0.0 && qo_squared.re >= 0.0 {
+    // The e-wave's exact flux: a lossless medium at real β (known per medium), where the
+    // e-wave propagates (w real).
+    let lossless = real_coefficients(medium, beta);
+    let ek_z =
+        (!lossless.known().is_some_and(|l| !l)).then(|| (lossless & w.im.equals(T::zero()), w.re));
+    let real_fields = lossless
+        & w.im.equals(T::zero())
+        & qo_squared.im.equals(T::zero())
+        & qo_squared.re.ge(T::zero());
+    if real_fields.surely() {
         let (eps_o, eps_e) = (medium.eps_o().re, medium.eps_e().re);
         let fields = Fields::new(eps_o, eps_e, medium.axis, beta.re);
         let q_re = [q[0].re, q[1].re, q[2].re, q[3].re];
@@ -315,10 +341,10 @@ pub fn uniaxial_modes(medium: &Uniaxial, beta: C64) -> ModeSet {
     }
 }
 
-/// A mode from its fields (in the arithmetic of `T`).
+/// A mode from its fields (in the arithmetic of `S`).
 #[inline(always)]
-fn mode<T: Scalar>(kind: ModeKind, beta: C64, q: C64, wave: Wave<T>) -> Mode {
-    let c = |v: &[T; 3]| Vector3::new(v[0].complex(), v[1].complex(), v[2].complex());
+fn mode<T: Real, S: Scalar<T>>(kind: ModeKind, beta: Cx<T>, q: Cx<T>, wave: Wave<S, T>) -> Mode<T> {
+    let c = |v: &[S; 3]| Vector3::new(v[0].complex(), v[1].complex(), v[2].complex());
     Mode {
         kind,
         beta,
@@ -330,24 +356,29 @@ fn mode<T: Scalar>(kind: ModeKind, beta: C64, q: C64, wave: Wave<T>) -> Mode {
 }
 
 /// The four modes from `fields` and the normal components `[o↓, e↓, o↑, e↑]` in the arithmetic
-/// of `T` (`q_t`) and as stored (`q`); `w` of the up-going e-wave for exact fluxes.
+/// of `S` (`q_s`) and as stored (`q`); `w` of the up-going e-wave for exact fluxes.
 #[inline(always)]
-fn uniaxial_pairs<T: Scalar>(
-    fields: &Fields<T>,
-    beta: C64,
-    q_t: [T; 4],
-    q: [C64; 4],
-    w: Option<f64>,
-) -> ModeSet {
+fn uniaxial_pairs<T: Real, S: Scalar<T>>(
+    fields: &Fields<S, T>,
+    beta: Cx<T>,
+    q_s: [S; 4],
+    q: [Cx<T>; 4],
+    w: Option<(T::Mask, T)>,
+) -> ModeSet<T> {
     let (o, e) = (ModeKind::O, ModeKind::E);
     ModeSet {
         down: [
-            mode(o, beta, q[0], fields.ordinary(q_t[0])),
-            mode(e, beta, q[1], fields.extraordinary(q_t[1], w.map(|w| -w))),
+            mode(o, beta, q[0], fields.ordinary(q_s[0])),
+            mode(
+                e,
+                beta,
+                q[1],
+                fields.extraordinary(q_s[1], w.map(|(m, w)| (m, -w))),
+            ),
         ],
         up: [
-            mode(o, beta, q[2], fields.ordinary(q_t[2])),
-            mode(e, beta, q[3], fields.extraordinary(q_t[3], w)),
+            mode(o, beta, q[2], fields.ordinary(q_s[2])),
+            mode(e, beta, q[3], fields.extraordinary(q_s[3], w)),
         ],
     }
 }

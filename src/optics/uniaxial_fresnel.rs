@@ -54,7 +54,7 @@ pub struct UniaxialFresnel<T> {
     inv_det: T,
 }
 
-impl<T: Scalar> UniaxialFresnel<T> {
+impl<T: Scalar<f64>> UniaxialFresnel<T> {
     /// The interface between an isotropic medium of index `eta` above (its up-going normal
     /// component `w`) and a crystal whose down-going modes have the tangential fields `down`.
     /// `None` if `M` is singular to working precision (a guided or surface wave; the criterion
@@ -95,7 +95,7 @@ impl<T: Scalar> UniaxialFresnel<T> {
         let minus_inv_eta = -self.eta.inverse();
         let ey = |col: usize| t[0][col] * o[1] + t[1][col] * e[1];
         let hy = |col: usize| (t[0][col] * o[3] + t[1][col] * e[3]) * minus_inv_eta;
-        let r = [[ey(0) - T::ONE, ey(1)], [hy(0), hy(1) - T::ONE]];
+        let r = [[ey(0) - T::one(), ey(1)], [hy(0), hy(1) - T::one()]];
         (r, t)
     }
 
