@@ -215,7 +215,7 @@ pub fn mul4(a: &Matrix4<C64>, b: &Matrix4<C64>) -> Matrix4<C64> {
 
 /// `a b`, written out.
 #[inline(always)]
-pub fn mul2(a: &Matrix2<C64>, b: &Matrix2<C64>) -> Matrix2<C64> {
+pub fn mul2<T: Real>(a: &Matrix2<Cx<T>>, b: &Matrix2<Cx<T>>) -> Matrix2<Cx<T>> {
     Matrix2::new(
         a[(0, 0)] * b[(0, 0)] + a[(0, 1)] * b[(1, 0)],
         a[(0, 0)] * b[(0, 1)] + a[(0, 1)] * b[(1, 1)],

@@ -1,16 +1,17 @@
 //! The local shading frame (Mitsuba's: `z` = surface normal towards the exterior) and the
 //! plane-of-incidence working frame of [`crate::optics::modes`].
 
+use crate::real::{Mask, Real};
 use nalgebra::Vector3;
 
 /// The plane-of-incidence frame expressed in the local frame: working `x` = `u` (direction of the
 /// tangential wave vector), working `y` = `s = ẑ × u` (the s direction), working `z` = `ẑ`.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PlaneFrame {
+pub struct PlaneFrame<T: Real = f64> {
     /// Unit tangential propagation direction (local frame, `u.z = 0`).
-    pub u: Vector3<f64>,
+    pub u: Vector3<T>,
     /// Unit s direction `ẑ × u` (local frame).
-    pub s: Vector3<f64>,
+    pub s: Vector3<T>,
 }
 
 impl PlaneFrame {
@@ -20,35 +21,39 @@ impl PlaneFrame {
     pub fn from_azimuth(phi: f64) -> Self {
         Self::from_u(Vector3::new(-phi.cos(), -phi.sin(), 0.0))
     }
+}
 
+impl<T: Real> PlaneFrame<T> {
     /// The frame for light arriving from the local direction `towards_light` (either
     /// hemisphere). At normal incidence the s direction falls back to `(1, 0, 0)`, as in
     /// Mitsuba's `dielectric`.
-    pub fn from_direction(towards_light: Vector3<f64>) -> Self {
-        let t = Vector3::new(-towards_light.x, -towards_light.y, 0.0);
-        let n = t.norm();
-        if n > 0.0 {
-            Self::from_u(t / n)
-        } else {
-            Self::from_u(Vector3::new(0.0, -1.0, 0.0))
-        }
+    pub fn from_direction(towards_light: Vector3<T>) -> Self {
+        let (x, y) = (-towards_light.x, -towards_light.y);
+        let n = (x * x + y * y).sqrt();
+        let zero = T::zero();
+        let (ux, uy) = n.gt(zero).when(
+            || (x / n, y / n),
+            || (zero, T::cst(-1.0)),
+        );
+        Self::from_u(Vector3::new(ux, uy, zero))
     }
 
-    fn from_u(u: Vector3<f64>) -> Self {
+    fn from_u(u: Vector3<T>) -> Self {
+        // ẑ × u, written out.
         PlaneFrame {
             u,
-            s: Vector3::z().cross(&u),
+            s: Vector3::new(-u.y, u.x, T::zero()),
         }
     }
 
     /// Local → working coordinates.
-    pub fn to_working(&self, v: Vector3<f64>) -> Vector3<f64> {
+    pub fn to_working(&self, v: Vector3<T>) -> Vector3<T> {
         Vector3::new(v.dot(&self.u), v.dot(&self.s), v.z)
     }
 
     /// Working → local coordinates.
-    pub fn to_local(&self, v: Vector3<f64>) -> Vector3<f64> {
-        self.u * v.x + self.s * v.y + Vector3::z() * v.z
+    pub fn to_local(&self, v: Vector3<T>) -> Vector3<T> {
+        self.u * v.x + self.s * v.y + Vector3::new(T::zero(), T::zero(), v.z)
     }
 }
 
@@ -64,7 +69,7 @@ mod tests {
             let v = Vector3::new(0.3, -0.5, 0.8);
             assert!((f.to_local(f.to_working(v)) - v).norm() < 1e-15);
         }
-        let f = PlaneFrame::from_direction(Vector3::z());
+        let f = PlaneFrame::from_direction(Vector3::<f64>::z());
         assert_eq!(f.s, Vector3::x());
         let w = Vector3::new(0.5_f64.sin(), 0.0, 0.5_f64.cos());
         let f = PlaneFrame::from_direction(w);

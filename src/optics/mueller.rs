@@ -6,6 +6,8 @@
 //! the Mueller matrix is `M = Re(A (J_m ⊗ J_m*) A⁻¹)`, `J_m = conj(J)`,
 //! `A = [[1,0,0,1],[1,0,0,−1],[0,1,1,0],[0,i,−i,0]]`. Written out below entry by entry.
 
+use crate::real::complex::Cx;
+use crate::real::Real;
 use nalgebra::{Matrix2, Matrix4};
 use num_complex::Complex64 as C64;
 
@@ -15,7 +17,7 @@ use num_complex::Complex64 as C64;
 /// Written out as `M_ij = ½ tr(σ_i J_m σ_j J_m†)` with Mitsuba's Stokes basis `σ₀ = I`,
 /// `σ₁ = diag(1, −1)`, `σ₂ = [[0,1],[1,0]]`, `σ₃ = [[0,−i],[i,0]]` (a real-arithmetic closed
 /// form; equal to `from_coherency(&coherency(j))`, which the tests check).
-pub fn from_jones(j: &Matrix2<C64>) -> Matrix4<f64> {
+pub fn from_jones<T: Real>(j: &Matrix2<Cx<T>>) -> Matrix4<T> {
     // Columns a, b of Mitsuba's Jones matrix conj(J).
     let (a0, a1) = (j[(0, 0)].conj(), j[(1, 0)].conj());
     let (b0, b1) = (j[(0, 1)].conj(), j[(1, 1)].conj());
@@ -26,18 +28,19 @@ pub fn from_jones(j: &Matrix2<C64>) -> Matrix4<f64> {
     let v = b1 * a0.conj();
     let w00 = a0 * b0.conj();
     let w11 = a1 * b1.conj();
-    let i = C64::new(0.0, 1.0);
-    // B_j = J σ_j J† as (B00, B11, B10) for j = 0..3.
+    let (two, half) = (T::cst(2.0), T::cst(0.5));
+    // B_j = J σ_j J† as (B00, B11, B10) for j = 0..3; i (v − u) written out.
+    let vu = v - u;
     let bs = [
         (p + r, q + s, x + y),
         (p - r, q - s, x - y),
-        (2.0 * w00.re, 2.0 * w11.re, u + v),
-        (2.0 * w00.im, 2.0 * w11.im, i * (v - u)),
+        (two * w00.re, two * w11.re, u + v),
+        (two * w00.im, two * w11.im, Cx::new(-vu.im, vu.re)),
     ];
-    let mut m = Matrix4::zeros();
+    let mut m = Matrix4::from_element(T::zero());
     for (col, (b00, b11, b10)) in bs.into_iter().enumerate() {
-        m[(0, col)] = 0.5 * (b00 + b11);
-        m[(1, col)] = 0.5 * (b00 - b11);
+        m[(0, col)] = half * (b00 + b11);
+        m[(1, col)] = half * (b00 - b11);
         m[(2, col)] = b10.re;
         m[(3, col)] = b10.im;
     }
@@ -124,7 +127,7 @@ pub fn from_coherency(k: &Matrix4<C64>) -> Matrix4<f64> {
 /// reversed beam's `y = k × x` changes sign, and with it `U`). Light from `−wo` that reaches
 /// `wi` retraces the wave that went from `−wi` to `wo`, so one forward solve gives both
 /// transport modes of a lobe.
-pub fn reversed(m: &Matrix4<f64>) -> Matrix4<f64> {
+pub fn reversed<T: Real>(m: &Matrix4<T>) -> Matrix4<T> {
     let mut r = m.transpose();
     for i in 0..4 {
         r[(i, 2)] = -r[(i, 2)];

@@ -23,32 +23,34 @@ use crate::optics::medium::Uniaxial;
 use crate::optics::modes::{modes, normal_components, ModeSet};
 use crate::optics::mueller;
 use crate::params::Thickness;
+use crate::real::complex::{self as cx, Cx};
+use crate::real::{Mask, Real};
 use nalgebra::{Matrix2, Matrix4};
 use num_complex::Complex64 as C64;
 
 /// A uniaxial plate between an isotropic top (light arrives from there) and bottom medium.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Slab {
+pub struct Slab<T: Real = f64> {
     /// Top (incident side) medium, isotropic.
-    pub top: Uniaxial,
+    pub top: Uniaxial<T>,
     /// The plate; optic axis in the local frame.
-    pub layer: Uniaxial,
+    pub layer: Uniaxial<T>,
     /// Bottom (exit side) medium, isotropic.
-    pub bottom: Uniaxial,
+    pub bottom: Uniaxial<T>,
     /// Thickness in nm (the unit of wavelengths).
-    pub thickness_nm: f64,
+    pub thickness_nm: T,
 }
 
 /// The wavelength-independent part of a slab for one incidence (at fixed indices): both
 /// interfaces, solved in the plane-of-incidence frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SlabOptics {
+pub struct SlabOptics<T: Real = f64> {
     /// Top interface (top medium above, layer below).
-    pub top: Interface,
+    pub top: Interface<T>,
     /// Bottom interface (layer above, bottom medium below).
-    pub bottom: Interface,
+    pub bottom: Interface<T>,
     /// Slab thickness in nm.
-    pub thickness_nm: f64,
+    pub thickness_nm: T,
 }
 
 /// Which lobes a query needs.
@@ -72,21 +74,21 @@ impl Want {
 /// (incident and reflected waves) and bottom (transmitted wave) media; flux-normalised, so
 /// `|J|²` entries are power fractions.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SlabJones {
+pub struct SlabJones<T: Real = f64> {
     /// Reflection (`None` if not asked for).
-    pub r: Option<Matrix2<C64>>,
+    pub r: Option<Matrix2<Cx<T>>>,
     /// Transmission (`None` if not asked for; zero if the exit wave is evanescent).
-    pub t: Option<Matrix2<C64>>,
+    pub t: Option<Matrix2<Cx<T>>>,
 }
 
 /// Mueller matrices (Mitsuba's convention) of a slab in the s/p frames of the top medium
 /// (reflection) and of the bottom medium (transmission); power fractions.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SlabMueller {
+pub struct SlabMueller<T: Real = f64> {
     /// Reflection.
-    pub r: Option<Matrix4<f64>>,
+    pub r: Option<Matrix4<T>>,
     /// Transmission.
-    pub t: Option<Matrix4<f64>>,
+    pub t: Option<Matrix4<T>>,
 }
 
 impl Slab {
@@ -100,9 +102,11 @@ impl Slab {
             thickness_nm: thickness.nm(),
         })
     }
+}
 
+impl<T: Real> Slab<T> {
     /// The layer's modes for incidence parameter `beta` in the plane of `frame`.
-    pub fn layer_modes(&self, frame: &PlaneFrame, beta: C64) -> ModeSet {
+    pub fn layer_modes(&self, frame: &PlaneFrame<T>, beta: Cx<T>) -> ModeSet<T> {
         modes(
             &self.layer.with_axis(frame.to_working(self.layer.axis)),
             beta,
@@ -110,7 +114,7 @@ impl Slab {
     }
 
     /// The layer's normal components `[o↓, e↓, o↑, e↑]` ([`normal_components`]).
-    pub fn layer_q(&self, frame: &PlaneFrame, beta: C64) -> [C64; 4] {
+    pub fn layer_q(&self, frame: &PlaneFrame<T>, beta: Cx<T>) -> [Cx<T>; 4] {
         normal_components(
             &self.layer.with_axis(frame.to_working(self.layer.axis)),
             beta,
@@ -118,7 +122,7 @@ impl Slab {
     }
 
     /// Solves both interfaces for incidence parameter `beta` in the plane of `frame`.
-    pub fn optics(&self, frame: &PlaneFrame, beta: C64) -> Result<SlabOptics> {
+    pub fn optics(&self, frame: &PlaneFrame<T>, beta: Cx<T>) -> Result<SlabOptics<T>> {
         let layer = self.layer.with_axis(frame.to_working(self.layer.axis));
         // Both interfaces solved where they lie ([`Interface::solve_in_place`]): they are
         // large, and moving them around costs about as much as solving them.
@@ -141,25 +145,25 @@ impl Slab {
     }
 }
 
-impl SlabOptics {
+impl<T: Real> SlabOptics<T> {
     /// The layer's modes.
-    pub fn layer_modes(&self) -> &ModeSet {
+    pub fn layer_modes(&self) -> &ModeSet<T> {
         &self.top.lower
     }
 
     /// Propagation factors `(P↓, P↑)` through the layer at vacuum wavelength `lambda_nm`.
-    pub fn propagation(&self, lambda_nm: f64) -> (Matrix2<C64>, Matrix2<C64>) {
+    pub fn propagation(&self, lambda_nm: T) -> (Matrix2<Cx<T>>, Matrix2<Cx<T>>) {
         propagation(self.thickness_nm, lambda_nm, &self.layer_q())
     }
 
     /// The layer's normal components `[o↓, e↓, o↑, e↑]`.
-    pub fn layer_q(&self) -> [C64; 4] {
+    pub fn layer_q(&self) -> [Cx<T>; 4] {
         let m = self.layer_modes();
         [m.down[0].q, m.down[1].q, m.up[0].q, m.up[1].q]
     }
 
     /// What [`SlabOptics::jones`] needs besides the wavelength.
-    pub fn blocks(&self) -> SlabBlocks {
+    pub fn blocks(&self) -> SlabBlocks<T> {
         SlabBlocks {
             r1: self.top.r_above(),
             t1: self.top.t_above(),
@@ -174,20 +178,17 @@ impl SlabOptics {
     }
 
     /// Flux ratio per unit amplitude `P_bottom / P_top` (transmission power factor, eq. S19).
-    pub fn transmission_flux_ratio(&self) -> f64 {
+    pub fn transmission_flux_ratio(&self) -> T {
         let p_in = self.top.upper.down[0].flux.abs();
         let p_out = self.bottom.lower.down[0].flux.abs();
-        if p_in > 0.0 && !self.bottom.lower.down[0].is_evanescent() {
-            p_out / p_in
-        } else {
-            0.0
-        }
+        let carries = p_in.gt(T::zero()) & !self.bottom.lower.down[0].is_evanescent();
+        carries.when(|| p_out / p_in, T::zero)
     }
 
     /// The coherent, flux-normalised Jones matrices at `lambda_nm` (all internal paths).
     /// Fails only at an exact internal resonance (`I − D` singular: a guided mode, which light
     /// from outside cannot excite in a passive slab).
-    pub fn jones(&self, lambda_nm: f64, want: Want) -> Result<SlabJones> {
+    pub fn jones(&self, lambda_nm: T, want: Want) -> Result<SlabJones<T>> {
         self.blocks().jones(lambda_nm, want)
     }
 
@@ -197,10 +198,10 @@ impl SlabOptics {
     /// but the phases do.
     pub fn mueller_with_phases(
         &self,
-        lambda_nm: f64,
-        q: &[C64; 4],
+        lambda_nm: T,
+        q: &[Cx<T>; 4],
         want: Want,
-    ) -> Result<SlabMueller> {
+    ) -> Result<SlabMueller<T>> {
         SlabBlocks {
             q: *q,
             ..self.blocks()
@@ -209,7 +210,7 @@ impl SlabOptics {
     }
 
     /// Mueller matrices (Mitsuba's convention, s/p frames) of reflection and transmission.
-    pub fn mueller(&self, lambda_nm: f64, want: Want) -> Result<SlabMueller> {
+    pub fn mueller(&self, lambda_nm: T, want: Want) -> Result<SlabMueller<T>> {
         let j = self.jones(lambda_nm, want)?;
         Ok(SlabMueller {
             r: j.r.as_ref().map(mueller::from_jones),
@@ -220,40 +221,54 @@ impl SlabOptics {
 
 /// Propagation factors `(P↓, P↑) = (diag exp(−i k0 q↓ d), diag exp(i k0 q↑ d))` of a layer of
 /// thickness `thickness_nm` with normal components `q = [o↓, e↓, o↑, e↑]`.
-fn propagation(thickness_nm: f64, lambda_nm: f64, q: &[C64; 4]) -> (Matrix2<C64>, Matrix2<C64>) {
+fn propagation<T: Real>(
+    thickness_nm: T,
+    lambda_nm: T,
+    q: &[Cx<T>; 4],
+) -> (Matrix2<Cx<T>>, Matrix2<Cx<T>>) {
     let (pd, pu) = phase_factors(thickness_nm, lambda_nm, q);
+    let zero = cx::real(T::zero());
     (
-        Matrix2::from_diagonal(&nalgebra::Vector2::new(pd[0], pd[1])),
-        Matrix2::from_diagonal(&nalgebra::Vector2::new(pu[0], pu[1])),
+        Matrix2::new(pd[0], zero, zero, pd[1]),
+        Matrix2::new(pu[0], zero, zero, pu[1]),
     )
 }
 
 /// The diagonals of [`propagation`]. The o-wave's `q↑ = −q↓` (bit for bit, as
 /// [`crate::optics::modes`] builds them) shares one exponential.
 #[inline]
-pub(crate) fn phase_factors(
-    thickness_nm: f64,
-    lambda_nm: f64,
-    q: &[C64; 4],
-) -> ([C64; 2], [C64; 2]) {
-    let kd = std::f64::consts::TAU * thickness_nm / lambda_nm;
-    let i = C64::new(0.0, 1.0);
-    let p = |k: usize, sign: f64| expi(i * q[k] * (sign * kd));
+pub(crate) fn phase_factors<T: Real>(
+    thickness_nm: T,
+    lambda_nm: T,
+    q: &[Cx<T>; 4],
+) -> ([Cx<T>; 2], [Cx<T>; 2]) {
+    let kd = thickness_nm * std::f64::consts::TAU / lambda_nm;
+    // exp(i q sign kd) = exp((−Im q, Re q) · sign kd).
+    let p = |k: usize, sign: f64| {
+        let f = kd * sign;
+        cx::exp(Cx::new(-q[k].im * f, q[k].re * f))
+    };
     let (down_o, down_e, up_e) = (p(0, -1.0), p(1, -1.0), p(3, 1.0));
     let up_o = if q[2] == -q[0] { down_o } else { p(2, 1.0) };
     ([down_o, down_e], [up_o, up_e])
 }
 
-/// `m⁻¹` by the adjugate with one division; `None` if the determinant is exactly zero (the
-/// criterion of `nalgebra`'s `try_inverse`, which this replaces on the hot path).
+/// `m⁻¹` by the adjugate with one division; the resonance error where the determinant is
+/// exactly zero (the criterion of `nalgebra`'s `try_inverse`, which this replaces on the hot
+/// path; while recording such lanes fail).
 #[inline]
-pub(crate) fn inverse(m: &Matrix2<C64>) -> Option<Matrix2<C64>> {
+pub(crate) fn inverse<T: Real>(m: &Matrix2<Cx<T>>) -> Result<Matrix2<Cx<T>>> {
     let det = m[(0, 0)] * m[(1, 1)] - m[(0, 1)] * m[(1, 0)];
-    if det == C64::new(0.0, 0.0) {
-        return None;
-    }
-    let r = cmath::inv(det);
-    Some(Matrix2::new(
+    let zero = T::zero();
+    let singular = det.re.equals(zero) & det.im.equals(zero);
+    singular.fail(|| {
+        Error::new(
+            "slab",
+            "internal resonance: the multiple-reflection sum diverges",
+        )
+    })?;
+    let r = cx::inv(singular.when(|| cx::real(T::one()), || det));
+    Ok(Matrix2::new(
         m[(1, 1)] * r,
         -m[(0, 1)] * r,
         -m[(1, 0)] * r,
@@ -261,20 +276,9 @@ pub(crate) fn inverse(m: &Matrix2<C64>) -> Option<Matrix2<C64>> {
     ))
 }
 
-/// `exp(z)`; for a purely imaginary `z` (a lossless layer) without the real exponential.
-#[inline(always)]
-fn expi(z: C64) -> C64 {
-    if z.re == 0.0 {
-        let (s, c) = z.im.sin_cos();
-        C64::new(c, s)
-    } else {
-        z.exp()
-    }
-}
-
 /// `diag(a) m`.
 #[inline]
-fn scale_rows(a: &[C64; 2], m: &Matrix2<C64>) -> Matrix2<C64> {
+fn scale_rows<T: Real>(a: &[Cx<T>; 2], m: &Matrix2<Cx<T>>) -> Matrix2<Cx<T>> {
     Matrix2::new(
         a[0] * m[(0, 0)],
         a[0] * m[(0, 1)],
@@ -285,7 +289,7 @@ fn scale_rows(a: &[C64; 2], m: &Matrix2<C64>) -> Matrix2<C64> {
 
 /// `diag(a) m diag(b)`.
 #[inline]
-pub(crate) fn scale(a: &[C64; 2], m: &Matrix2<C64>, b: &[C64; 2]) -> Matrix2<C64> {
+pub(crate) fn scale<T: Real>(a: &[Cx<T>; 2], m: &Matrix2<Cx<T>>, b: &[Cx<T>; 2]) -> Matrix2<Cx<T>> {
     Matrix2::new(
         a[0] * m[(0, 0)] * b[0],
         a[0] * m[(0, 1)] * b[1],
@@ -299,43 +303,39 @@ pub(crate) fn scale(a: &[C64; 2], m: &Matrix2<C64>, b: &[C64; 2]) -> Matrix2<C64
 /// components and the transmission flux factor. With the wavelength they give the plate
 /// (module docs); across a spectrum they can be interpolated (they vary only with the indices).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SlabBlocks {
+pub struct SlabBlocks<T: Real = f64> {
     /// Top interface, reflection from above.
-    pub r1: Matrix2<C64>,
+    pub r1: Matrix2<Cx<T>>,
     /// Top interface, transmission from above.
-    pub t1: Matrix2<C64>,
+    pub t1: Matrix2<Cx<T>>,
     /// Top interface, reflection from below.
-    pub r3: Matrix2<C64>,
+    pub r3: Matrix2<Cx<T>>,
     /// Top interface, transmission from below.
-    pub t3: Matrix2<C64>,
+    pub t3: Matrix2<Cx<T>>,
     /// Bottom interface, reflection from above.
-    pub r2: Matrix2<C64>,
+    pub r2: Matrix2<Cx<T>>,
     /// Bottom interface, transmission from above.
-    pub t2: Matrix2<C64>,
+    pub t2: Matrix2<Cx<T>>,
     /// Layer normal components `[o↓, e↓, o↑, e↑]`.
-    pub q: [C64; 4],
+    pub q: [Cx<T>; 4],
     /// Transmission flux factor `P_bottom / P_top`.
-    pub flux: f64,
+    pub flux: T,
     /// Thickness (nm).
-    pub thickness_nm: f64,
+    pub thickness_nm: T,
 }
 
 /// Number of complex values in [`SlabBlocks::values`].
 pub const BLOCK_VALUES: usize = 29;
 
-impl SlabBlocks {
+impl<T: Real> SlabBlocks<T> {
     /// The Jones matrices at `lambda_nm` ([`SlabOptics::jones`]).
-    pub fn jones(&self, lambda_nm: f64, want: Want) -> Result<SlabJones> {
+    pub fn jones(&self, lambda_nm: T, want: Want) -> Result<SlabJones<T>> {
         let (pd, pu) = phase_factors(self.thickness_nm, lambda_nm, &self.q);
         // P↑ r₂ P↓, shared by the round trip D and the reflected paths.
         let trip = scale(&pu, &self.r2, &pd);
         let d = cmath::mul2(&self.r3, &trip);
-        let inverse = inverse(&(Matrix2::identity() - d)).ok_or_else(|| {
-            Error::new(
-                "slab",
-                "internal resonance: the multiple-reflection sum diverges",
-            )
-        })?;
+        let (one, zero) = (cx::real(T::one()), cx::real(T::zero()));
+        let inverse = inverse(&(Matrix2::new(one, zero, zero, one) - d))?;
         let inner = cmath::mul2(&inverse, &self.t1);
         let r = want
             .reflection
@@ -348,7 +348,7 @@ impl SlabBlocks {
     }
 
     /// The Mueller matrices at `lambda_nm` ([`SlabOptics::mueller`]).
-    pub fn mueller(&self, lambda_nm: f64, want: Want) -> Result<SlabMueller> {
+    pub fn mueller(&self, lambda_nm: T, want: Want) -> Result<SlabMueller<T>> {
         let j = self.jones(lambda_nm, want)?;
         Ok(SlabMueller {
             r: j.r.as_ref().map(mueller::from_jones),
@@ -358,9 +358,12 @@ impl SlabBlocks {
 
     /// The diagonals of the propagation matrices `(P↓, P↑)` at `lambda_nm` (attenuation
     /// included for complex `q`).
-    pub fn propagation(&self, lambda_nm: f64) -> ([C64; 2], [C64; 2]) {
+    pub fn propagation(&self, lambda_nm: T) -> ([Cx<T>; 2], [Cx<T>; 2]) {
         phase_factors(self.thickness_nm, lambda_nm, &self.q)
     }
+}
+
+impl SlabBlocks {
 
     /// All values as one array (blocks row by row, then `q`, then the flux).
     pub fn values(&self) -> [C64; BLOCK_VALUES] {

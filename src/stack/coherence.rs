@@ -211,7 +211,7 @@ fn from_above(
         let t = scale(&[C64::new(1.0, 0.0); 2], &tau, &pd);
         let iface = &blocks.interfaces[j];
         let x = inverse(&(Matrix2::identity() - cmath::mul2(&iface[R_UP], &g)))
-            .ok_or_else(resonance)?;
+            .map_err(|_| resonance())?;
         let y = cmath::mul2(&x, &iface[T_DOWN]);
         tau = cmath::mul2(&t, &y);
         gamma = iface[R_DOWN] + cmath::mul2(&iface[T_UP], &cmath::mul2(&g, &y));
@@ -244,8 +244,8 @@ fn segment(
 fn star(a: &[Matrix2<C64>; 4], b: &[Matrix2<C64>; 4]) -> Result<[Matrix2<C64>; 4]> {
     let id = Matrix2::identity();
     let mul = cmath::mul2;
-    let d = inverse(&(id - mul(&a[R_UP], &b[R_DOWN]))).ok_or_else(resonance)?;
-    let e = inverse(&(id - mul(&b[R_DOWN], &a[R_UP]))).ok_or_else(resonance)?;
+    let d = inverse(&(id - mul(&a[R_UP], &b[R_DOWN]))).map_err(|_| resonance())?;
+    let e = inverse(&(id - mul(&b[R_DOWN], &a[R_UP]))).map_err(|_| resonance())?;
     let da = mul(&d, &a[T_DOWN]);
     let eb = mul(&e, &b[T_UP]);
     Ok([

@@ -189,7 +189,7 @@ impl StackBlocks {
             let g = scale(&pu, &gamma, &pd);
             let iface = &self.interfaces[j];
             let x = inverse(&(Matrix2::identity() - cmath::mul2(&iface[R_UP], &g)))
-                .ok_or_else(resonance)?;
+                .map_err(|_| resonance())?;
             let y = cmath::mul2(&x, &iface[T_DOWN]);
             // τ P↓ (I − r↑ Γ')⁻¹ t↓, associated as the slab does (τ (P↓ y)).
             tau = cmath::mul2(&tau, &scale(&pd, &y, &[C64::new(1.0, 0.0); 2]));
