@@ -20,6 +20,7 @@
 //! fit's range is allowed and returns the formula's value; see
 //! [`Dispersion::index`] for what happens where the formula breaks down.
 
+use crate::real::{Mask, Real};
 use std::borrow::Cow;
 
 /// One additive term of a Sellmeier-type expression for `n²(λ)`, `λ` in µm.
@@ -40,11 +41,11 @@ pub enum Term {
 
 impl Term {
     /// Value of the term at `l2 = λ²` (µm²).
-    fn eval(&self, l2: f64) -> f64 {
+    fn eval<T: Real>(&self, l2: T) -> T {
         match *self {
-            Term::Oscillator { b, c } => b * l2 / (l2 - c),
-            Term::Pole { b, c } => b / (l2 - c),
-            Term::Power { d, p } => d * l2.sqrt().powi(p),
+            Term::Oscillator { b, c } => l2 * b / (l2 - c),
+            Term::Pole { b, c } => T::cst(b) / (l2 - c),
+            Term::Power { d, p } => powi(l2.sqrt(), p) * d,
         }
     }
 
@@ -98,30 +99,40 @@ impl Dispersion {
     /// finite and positive or the formula's value there is not a finite,
     /// positive real number.
     pub fn try_index(&self, wavelength_nm: f64) -> Option<f64> {
-        if !(wavelength_nm.is_finite() && wavelength_nm > 0.0) {
-            return None;
-        }
-        let l2 = (wavelength_nm / 1000.0).powi(2);
-        let n = match self {
-            Dispersion::Constant(n) => *n,
-            Dispersion::Cauchy(coeffs) => {
-                // Horner's scheme in x = 1/λ².
-                let x = 1.0 / l2;
-                coeffs.iter().rev().fold(0.0, |acc, &c| acc * x + c)
-            }
-            Dispersion::Sellmeier { a, terms } => {
-                let n2 = terms.iter().fold(*a, |acc, t| acc + t.eval(l2));
-                if !(n2.is_finite() && n2 > 0.0) {
-                    return None;
-                }
-                n2.sqrt()
-            }
-        };
-        (n.is_finite() && n > 0.0).then_some(n)
+        let (n, valid) = self.evaluate(wavelength_nm);
+        valid.then_some(n)
     }
 
-    /// Wavelengths (nm, ascending) at which the formula has a pole. A fit must
-    /// only be used on intervals that contain none of them.
+    /// [`Dispersion::index`] over the reals `T` (a wavelength per lane while recording).
+    pub fn index_of<T: Real>(&self, wavelength_nm: T) -> T {
+        let (n, valid) = self.evaluate(wavelength_nm);
+        valid.when(|| n, T::one)
+    }
+
+    /// `(n(λ), valid)`: the fit at `wavelength_nm` (nm; the fits take µm) and whether it is a
+    /// valid index.
+    fn evaluate<T: Real>(&self, wavelength_nm: T) -> (T, T::Mask) {
+        let zero = T::zero();
+        let positive = |x: T| x.finite() & x.gt(zero);
+        let given = positive(wavelength_nm);
+        let micrometres = wavelength_nm / 1000.0;
+        let l2 = micrometres * micrometres;
+        let (n, valid) = match self {
+            Dispersion::Constant(n) => (T::cst(*n), given),
+            Dispersion::Cauchy(coeffs) => {
+                let x = l2.recip();
+                let n = coeffs.iter().rev().fold(zero, |acc, &c| acc * x + c);
+                (n, given & T::Mask::cst(!coeffs.is_empty()))
+            }
+            Dispersion::Sellmeier { a, terms } => {
+                let n2 = terms.iter().fold(T::cst(*a), |acc, t| acc + t.eval(l2));
+                let ok = positive(n2);
+                (ok.when(|| n2.sqrt(), T::one), given & ok)
+            }
+        };
+        (n, valid & positive(n))
+    }
+
     pub fn poles_nm(&self) -> Vec<f64> {
         let mut poles: Vec<f64> = match self {
             Dispersion::Sellmeier { terms, .. } => terms.iter().filter_map(Term::pole_nm).collect(),
@@ -203,4 +214,10 @@ mod tests {
         assert_eq!(Dispersion::Constant(f64::NAN).index(500.0), 1.0);
         assert_eq!(Dispersion::Constant(-1.0).try_index(500.0), None);
     }
+}
+
+/// `x^p` for a small integer `p`, by repeated multiplication (what `powi` does).
+fn powi<T: Real>(x: T, p: i32) -> T {
+    let base = if p < 0 { x.recip() } else { x };
+    (0..p.unsigned_abs()).fold(T::one(), |acc, _| acc * base)
 }

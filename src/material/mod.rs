@@ -5,6 +5,8 @@ pub mod dispersion;
 
 use crate::error::{Error, Result};
 use crate::material::crystals::Crystal;
+use crate::real::complex::Cx;
+use crate::real::{Mask, Real};
 use num_complex::Complex64 as C64;
 
 /// Vacuum wavelengths accepted (nm): X-rays to millimetre waves; the optics is continuum
@@ -30,11 +32,12 @@ pub fn check_wavelength(lambda_nm: f64) -> Result<()> {
     }
 }
 
-/// One principal index: `n(λ) + iκ`.
+/// One principal index: `n(λ) + iκ`, over the reals `T` (`f64`, or the recorded numbers of a
+/// program whose indices are inputs).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Index {
+pub enum Index<T: Real = f64> {
     /// Wavelength-independent.
-    Constant(C64),
+    Constant(Cx<T>),
     /// A named crystal's ordinary or extraordinary dispersion, plus a constant extinction.
     Crystal {
         /// The crystal's dispersion data.
@@ -42,14 +45,14 @@ pub enum Index {
         /// `true` for the extraordinary index.
         extraordinary: bool,
         /// Extinction coefficient κ.
-        kappa: f64,
+        kappa: T,
     },
 }
 
-impl Index {
+impl<T: Real> Index<T> {
     /// The complex index at `lambda_nm`. Crystal fits are evaluated outside their range too
     /// (what callers accept there is [`Material::coverage`]).
-    pub fn at(&self, lambda_nm: f64) -> C64 {
+    pub fn at(&self, lambda_nm: T) -> Cx<T> {
         match *self {
             Index::Constant(n) => n,
             Index::Crystal {
@@ -62,7 +65,7 @@ impl Index {
                 } else {
                     &crystal.ordinary
                 };
-                C64::new(d.index(lambda_nm), kappa)
+                Cx::new(d.index_of(lambda_nm), kappa)
             }
         }
     }
@@ -75,11 +78,30 @@ impl Index {
 
 /// Ordinary and extraordinary indices of a uniaxial material.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Material {
+pub struct Material<T: Real = f64> {
     /// Ordinary index.
-    pub eta_o: Index,
+    pub eta_o: Index<T>,
     /// Extraordinary index.
-    pub eta_e: Index,
+    pub eta_e: Index<T>,
+}
+
+impl<T: Real> Material<T> {
+    /// `(η_o, η_e)` at `lambda_nm`, with `birefringence` added to `Re η_e` (photoelastic
+    /// stress: `n_e − n_o = C (σ₁ − σ₂)` on an isotropic material). Fails (naming the
+    /// parameter) if the result is not a valid index; while recording, such lanes fail.
+    pub fn indices(&self, lambda_nm: T, birefringence: T) -> Result<(Cx<T>, Cx<T>)> {
+        if let (Some(lambda_nm), Some(b)) = (lambda_nm.value(), birefringence.value()) {
+            check_wavelength(lambda_nm)?;
+            if !b.is_finite() {
+                return Err(Error::new("birefringence", "must be finite"));
+            }
+        }
+        let eo = checked_index("eta_o", self.eta_o.at(lambda_nm))?;
+        let ee = self.eta_e.at(lambda_nm) + birefringence;
+        let added = birefringence.value() != Some(0.0);
+        checked_index(if added { "birefringence" } else { "eta_e" }, ee)?;
+        Ok((eo, ee))
+    }
 }
 
 impl Material {
@@ -115,27 +137,6 @@ impl Material {
             eta_o: index(false, kappa_o),
             eta_e: index(true, kappa_e),
         })
-    }
-
-    /// `(η_o, η_e)` at `lambda_nm`, with `birefringence` added to `Re η_e` (photoelastic
-    /// stress: `n_e − n_o = C (σ₁ − σ₂)` on an isotropic material). Fails (naming the
-    /// parameter) if the result is not a valid index.
-    pub fn indices(&self, lambda_nm: f64, birefringence: f64) -> Result<(C64, C64)> {
-        check_wavelength(lambda_nm)?;
-        if !birefringence.is_finite() {
-            return Err(Error::new("birefringence", "must be finite"));
-        }
-        let eo = check_index("eta_o", self.eta_o.at(lambda_nm))?;
-        let ee = self.eta_e.at(lambda_nm) + birefringence;
-        let ee = check_index(
-            if birefringence == 0.0 {
-                "eta_e"
-            } else {
-                "birefringence"
-            },
-            ee,
-        )?;
-        Ok((eo, ee))
     }
 
     /// True if any index varies with wavelength.
@@ -242,6 +243,22 @@ pub fn check_kappa(parameter: &str, kappa: f64) -> Result<f64> {
             format!("must be within [0, {KAPPA_MAX}], got {kappa}"),
         ))
     }
+}
+
+/// [`check_index`] over the reals `T`: the full check with its message where the index is
+/// known; while recording, the lanes where it is not a valid index fail.
+pub fn checked_index<T: Real>(parameter: &str, eta: Cx<T>) -> Result<Cx<T>> {
+    if let (Some(re), Some(im)) = (eta.re.value(), eta.im.value()) {
+        check_index(parameter, C64::new(re, im))?;
+        return Ok(eta);
+    }
+    let (lo, hi) = (T::cst(INDEX_RANGE.0), T::cst(INDEX_RANGE.1));
+    let valid = eta.re.ge(lo)
+        & eta.re.le(hi)
+        & eta.im.ge(T::zero())
+        & eta.im.le(T::cst(KAPPA_MAX));
+    (!valid).fail(|| Error::new(parameter, "not a valid index"))?;
+    Ok(eta)
 }
 
 /// Validates one complex index `n + iκ`: finite, `n` within [`INDEX_RANGE`], `0 <= κ <=`

@@ -13,6 +13,8 @@ use crate::optics::frame::PlaneFrame;
 use crate::optics::medium::Uniaxial;
 use crate::plate::etalon::Etalon;
 use crate::plate::slab::Slab;
+use crate::real::complex::Cx;
+use crate::real::Real;
 use nalgebra::Vector3;
 use num_complex::Complex64 as C64;
 
@@ -22,33 +24,40 @@ use num_complex::Complex64 as C64;
 /// ([`crate::render::plate::PlateQuery::new`], the calculator's reader): real exterior and exit
 /// indices, a unit optic axis, a [`crate::params::Thickness`]. [`Plate::at`] relies on that.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Plate {
+pub struct Plate<T: Real = f64> {
     /// The plate's material.
-    pub material: Material,
+    pub material: Material<T>,
     /// Added to `Re η_e` (photoelastic stress).
-    pub birefringence: f64,
+    pub birefringence: T,
     /// Exterior (incident side) index.
-    pub ext: C64,
+    pub ext: Cx<T>,
     /// Exit side index.
-    pub exit: C64,
-    /// Optic axis, local frame.
-    pub axis: Vector3<f64>,
+    pub exit: Cx<T>,
+    /// Optic axis, local frame (any non-zero length: [`Plate::at`] normalises it).
+    pub axis: Vector3<T>,
     /// Thickness (nm).
-    pub thickness_nm: f64,
+    pub thickness_nm: T,
 }
 
-impl Plate {
-    /// The slab at `lambda_nm` (the plate's own parameters are not checked again).
-    pub fn at(&self, lambda_nm: f64) -> Result<Slab> {
-        let (eo, ee) = self.material.indices(lambda_nm, self.birefringence)?;
+impl<T: Real> Plate<T> {
+    /// The slab at `lambda_nm` (the plate's own parameters are not checked again: the indices
+    /// at the wavelength are).
+    pub fn at(&self, lambda_nm: T) -> Result<Slab<T>> {
+        let (eta_o, eta_e) = self.material.indices(lambda_nm, self.birefringence)?;
         Ok(Slab {
-            top: Uniaxial::isotropic(self.ext)?,
-            layer: Uniaxial::new(eo, ee, self.axis)?,
-            bottom: Uniaxial::isotropic(self.exit)?,
+            top: Uniaxial::isotropic_unchecked(self.ext),
+            layer: Uniaxial {
+                eta_o,
+                eta_e,
+                axis: self.axis / self.axis.dot(&self.axis).sqrt(),
+            },
+            bottom: Uniaxial::isotropic_unchecked(self.exit),
             thickness_nm: self.thickness_nm,
         })
     }
+}
 
+impl Plate {
     /// The layer's normal components `[o↓, e↓, o↑, e↑]` at `lambda_nm` for incidence parameter
     /// `beta` in the plane of `frame` (what [`Slab::layer_q`] gives, without building the slab).
     pub fn layer_q(&self, lambda_nm: f64, frame: &PlaneFrame, beta: C64) -> Result<[C64; 4]> {
