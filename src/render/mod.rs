@@ -19,6 +19,7 @@ pub mod stack;
 pub mod tangents;
 pub mod thin;
 
+use crate::real::{Mask, Real};
 use nalgebra::{Matrix4, Vector3};
 
 /// Mitsuba's transport modes.
@@ -30,38 +31,42 @@ pub enum Transport {
     Importance,
 }
 
-/// One sampled lobe.
+/// One sampled lobe, over the reals `T` (`f64` on the host).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PathLobe {
+pub struct PathLobe<T: Real = f64> {
     /// Crystal: 0 reflection, 1 ordinary, 2 extraordinary transmission; plate: 0 R, 1 T.
     pub component: usize,
     /// Mitsuba's `wo` (unit, local).
-    pub wo: Vector3<f64>,
+    pub wo: Vector3<T>,
     /// `x` axis of the Stokes frame of the light arriving along `−wo_hat`.
-    pub in_stokes_x: Vector3<f64>,
+    pub in_stokes_x: Vector3<T>,
     /// `x` axis of the Stokes frame of the light leaving along `wi_hat`.
-    pub out_stokes_x: Vector3<f64>,
+    pub out_stokes_x: Vector3<T>,
     /// Physical Mueller matrix (Mitsuba's convention); in Radiance mode scaled by
     /// `(n_wi / n_wo)²` (radiance across an index step, ray indices of eq. S14).
-    pub mueller: Matrix4<f64>,
+    pub mueller: Matrix4<T>,
     /// `mueller[(0,0)]`, the unpolarised throughput.
-    pub weight: f64,
+    pub weight: T,
     /// The unpolarised power fraction of the physical transfer (`weight` without the radiance
     /// factor of Radiance mode; the same in both modes): what a lobe is chosen by
     /// ([`choice`]), as Mitsuba's own `dielectric` chooses by its Fresnel reflectance.
-    pub power: f64,
+    pub power: T,
     /// Mitsuba's `bs.eta`: ray index on the `wo` side over the `wi` side.
-    pub eta: f64,
+    pub eta: T,
+    /// Where the lobe exists: always on the host (a lobe that does not exist is `None` there);
+    /// in a recorded program, the lanes that have it (total internal reflection removes a
+    /// transmission in some lanes only).
+    pub exists: T::Mask,
 }
 
-impl PathLobe {
+impl<T: Real> PathLobe<T> {
     /// A lobe whose weight and power are its Mueller matrix's `M00`; `stokes_x` = (in, out).
     pub fn new(
         component: usize,
-        wo: Vector3<f64>,
-        (in_stokes_x, out_stokes_x): (Vector3<f64>, Vector3<f64>),
-        mueller: Matrix4<f64>,
-        eta: f64,
+        wo: Vector3<T>,
+        (in_stokes_x, out_stokes_x): (Vector3<T>, Vector3<T>),
+        mueller: Matrix4<T>,
+        eta: T,
     ) -> Self {
         PathLobe {
             component,
@@ -72,15 +77,24 @@ impl PathLobe {
             weight: mueller[(0, 0)],
             power: mueller[(0, 0)],
             eta,
+            exists: T::Mask::cst(true),
         }
     }
 
     /// The lobe with its Mueller matrix and weight multiplied by the radiance factor `factor`
     /// (Radiance mode, `(n_wi / n_wo)²`), its power fraction unchanged.
-    pub fn with_radiance_factor(self, factor: f64) -> Self {
+    pub fn with_radiance_factor(self, factor: T) -> Self {
         PathLobe {
             mueller: self.mueller * factor,
             weight: self.weight * factor,
+            ..self
+        }
+    }
+
+    /// The lobe where `exists` holds (and where it existed before).
+    pub fn existing(self, exists: T::Mask) -> Self {
+        PathLobe {
+            exists: self.exists & exists,
             ..self
         }
     }

@@ -179,7 +179,38 @@ pub fn plate_lobes_full(
     thin::lobes(q, spectrum, wi, transport, false)
 }
 
+impl PlateQuery {
+    /// The plate seen from below: exterior and exit swapped, mirrored through `z = 0`.
+    fn flipped(&self) -> Self {
+        let mut q = *self;
+        q.plate.ext = self.plate.exit;
+        q.plate.exit = self.plate.ext;
+        q.plate.axis.z = -q.plate.axis.z;
+        q
+    }
+}
+
 impl Thin for PlateQuery {
+    type Spectrum = Spectrum;
+
+    fn channels(spectrum: &Spectrum) -> Result<usize> {
+        let channels = spectrum.channels()?;
+        spectrum.validate()?;
+        Ok(channels)
+    }
+
+    fn is_signed(spectrum: &Spectrum) -> bool {
+        spectrum.is_signed()
+    }
+
+    fn oriented(&self, below: bool) -> Self {
+        if below {
+            self.flipped()
+        } else {
+            self.clone()
+        }
+    }
+
     fn want(&self) -> Want {
         self.want
     }
@@ -198,14 +229,6 @@ impl Thin for PlateQuery {
 
     fn exit(&self) -> f64 {
         self.plate.exit.re
-    }
-
-    fn flipped(&self) -> Self {
-        let mut q = *self;
-        q.plate.ext = self.plate.exit;
-        q.plate.exit = self.plate.ext;
-        q.plate.axis.z = -q.plate.axis.z;
-        q
     }
 
     /// Through the plate's model for this incidence (the one decision of [`PlateModel::new`]).

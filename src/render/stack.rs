@@ -76,7 +76,37 @@ pub fn stack_lobes_full(
     thin::lobes(q, spectrum, wi, transport, false)
 }
 
+impl StackQuery {
+    /// The stack seen from below: exterior and exit swapped, mirrored through `z = 0`.
+    fn flipped(&self) -> Self {
+        StackQuery {
+            stack: self.stack.flipped(),
+            ..self.clone()
+        }
+    }
+}
+
 impl Thin for StackQuery {
+    type Spectrum = Spectrum;
+
+    fn channels(spectrum: &Spectrum) -> Result<usize> {
+        let channels = spectrum.channels()?;
+        spectrum.validate()?;
+        Ok(channels)
+    }
+
+    fn is_signed(spectrum: &Spectrum) -> bool {
+        spectrum.is_signed()
+    }
+
+    fn oriented(&self, below: bool) -> Self {
+        if below {
+            self.flipped()
+        } else {
+            self.clone()
+        }
+    }
+
     fn want(&self) -> Want {
         self.want
     }
@@ -95,13 +125,6 @@ impl Thin for StackQuery {
 
     fn exit(&self) -> f64 {
         self.stack.exit.re
-    }
-
-    fn flipped(&self) -> Self {
-        StackQuery {
-            stack: self.stack.flipped(),
-            ..self.clone()
-        }
     }
 
     fn evaluate(

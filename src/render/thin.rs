@@ -14,13 +14,15 @@ use crate::error::{Error, Result};
 use crate::optics::frame::PlaneFrame;
 use crate::optics::mueller::reversed;
 use crate::plate::slab::{Output, SlabMueller, Want};
-use crate::render::plate::Spectrum;
+use crate::real::complex::{self as cx, Cx};
+use crate::real::{Mask, Real, Select};
 use crate::render::{PathLobe, Transport};
 use nalgebra::{Matrix4, Vector3};
-use num_complex::Complex64 as C64;
 
-/// A thin element as the lobes need it.
-pub trait Thin: Sized {
+/// A thin element as the lobes need it, over the reals `T` (`f64` on the host).
+pub trait Thin<T: Real = f64>: Sized {
+    /// What it is evaluated over: a spectrum (bands, channel weights), or wavelengths.
+    type Spectrum: ?Sized;
     /// Which lobes are asked for.
     fn want(&self) -> Want;
     /// Only `M00`.
@@ -28,48 +30,62 @@ pub trait Thin: Sized {
     /// The exit medium absorbs whatever enters it: no transmission lobe, no light from below.
     fn absorbing_exit(&self) -> bool;
     /// Real index of the exterior (above, `z > 0`).
-    fn ext(&self) -> f64;
+    fn ext(&self) -> T;
     /// Real index of the exit medium (below).
-    fn exit(&self) -> f64;
-    /// The element seen from below: exterior and exit swapped, mirrored through `z = 0`.
-    fn flipped(&self) -> Self;
+    fn exit(&self) -> T;
+    /// The element seen from below where `below` holds: exterior and exit swapped, mirrored
+    /// through `z = 0`.
+    fn oriented(&self, below: T::Mask) -> Self;
+    /// The channels of `spectrum`, checked.
+    fn channels(spectrum: &Self::Spectrum) -> Result<usize>;
+    /// True if a channel's weight can be negative (signed sRGB channels).
+    fn is_signed(spectrum: &Self::Spectrum) -> bool;
     /// Mueller matrices (s/p frames) per channel of `spectrum` for light from above with
     /// incidence parameter `beta` in the plane of `frame`.
     fn evaluate(
         &self,
-        spectrum: &Spectrum,
-        frame: PlaneFrame,
-        beta: C64,
+        spectrum: &Self::Spectrum,
+        frame: PlaneFrame<T>,
+        beta: Cx<T>,
         want: Want,
-    ) -> Result<Vec<SlabMueller>>;
+    ) -> Result<Vec<SlabMueller<T>>>;
 }
 
 /// The element's lobes seen from `wi`, one `[reflection, transmission]` pair per spectral
 /// channel (module docs). `share`: one solve for both lobes (else each lobe solved on its own,
 /// the reference the shared solution is tested against).
-pub fn lobes<E: Thin>(
+pub fn lobes<T: Real, E: Thin<T>>(
     e: &E,
-    spectrum: &Spectrum,
-    wi: Vector3<f64>,
+    spectrum: &E::Spectrum,
+    wi: Vector3<T>,
     transport: Transport,
     share: bool,
-) -> Result<Vec<[Option<PathLobe>; 2]>> {
-    if !(wi.iter().all(|x| x.is_finite()) && (wi.norm() - 1.0).abs() < 1e-4) {
-        return Err(Error::new("wi", "must be a unit vector"));
-    }
-    let channels = spectrum.channels()?;
-    spectrum.validate()?;
+) -> Result<Vec<[Option<PathLobe<T>>; 2]>> {
+    let norm = wi.dot(&wi).sqrt();
+    let finite = wi.iter().fold(T::Mask::cst(true), |m, x| m & x.finite());
+    let unit = finite & (norm - T::one()).abs().lt(T::cst(1e-4));
+    (!unit).fail(|| Error::new("wi", "must be a unit vector"))?;
+    let channels = E::channels(spectrum)?;
     let mut out = vec![[None, None]; channels];
-    if wi.z == 0.0 || (e.absorbing_exit() && wi.z < 0.0) {
+    let zero = T::zero();
+    let grazing = wi.z.equals(zero);
+    let dark = if e.absorbing_exit() {
+        grazing | wi.z.lt(zero)
+    } else {
+        grazing
+    };
+    if dark.surely() {
         return Ok(out);
     }
     let mut want = e.want();
     want.transmission &= !e.absorbing_exit();
-    let wi = wi.normalize();
+    let wi = wi / norm;
     let reflected = Vector3::new(-wi.x, -wi.y, wi.z);
+    let (through, transmits) = through(e, wi);
     let lobes = [
-        Some(reflected).filter(|_| want.reflection),
-        through(e, wi).filter(|_| want.transmission),
+        want.reflection.then_some((reflected, !dark)),
+        (want.transmission && transmits.known() != Some(false))
+            .then_some((through, !dark & transmits)),
     ];
     let shared = if share {
         let want = Want {
@@ -80,8 +96,9 @@ pub fn lobes<E: Thin>(
     } else {
         None
     };
-    for (component, wo) in lobes.into_iter().enumerate() {
-        let Some(wo) = wo else { continue };
+    let signed = E::is_signed(spectrum);
+    for (component, lobe) in lobes.into_iter().enumerate() {
+        let Some((wo, exists)) = lobe else { continue };
         let towards = match transport {
             Transport::Importance => wi,
             Transport::Radiance => wo,
@@ -92,7 +109,7 @@ pub fn lobes<E: Thin>(
         };
         // Shared: solved from wi's side; a Radiance lobe is its reversed path.
         let own;
-        let (ms, reverse): (&[SlabMueller], bool) = match &shared {
+        let (ms, reverse): (&[SlabMueller<T>], bool) = match &shared {
             Some(ms) => (ms, transport == Transport::Radiance),
             None => {
                 own = physical(e, spectrum, towards, want)?;
@@ -100,9 +117,10 @@ pub fn lobes<E: Thin>(
             }
         };
         let (n_in, n_out) = side_indices(e, towards, component);
+        let ratio = n_out / n_in;
         let scale = match transport {
-            Transport::Radiance => (n_out / n_in).powi(2),
-            Transport::Importance => 1.0,
+            Transport::Radiance => ratio * ratio,
+            Transport::Importance => T::one(),
         };
         let s = PlaneFrame::from_direction(towards).s;
         for (c, m) in ms.iter().enumerate() {
@@ -112,15 +130,17 @@ pub fn lobes<E: Thin>(
             // A band-averaged coherency of an element that passes (almost) nothing can give M00
             // a rounding-level negative (seen: -2e-22); under a non-negative weight the
             // unpolarised throughput is >= 0. (A signed sRGB channel keeps its sign.)
-            if !spectrum.is_signed() {
-                mueller[(0, 0)] = mueller[(0, 0)].max(0.0);
+            if !signed {
+                mueller[(0, 0)] = mueller[(0, 0)].max(zero);
             }
             let eta = match transport {
                 Transport::Radiance => n_in / n_out,
                 Transport::Importance => n_out / n_in,
             };
             out[c][component] = Some(
-                PathLobe::new(component, wo, (s, s), mueller, eta).with_radiance_factor(scale),
+                PathLobe::new(component, wo, (s, s), mueller, eta)
+                    .with_radiance_factor(scale)
+                    .existing(exists),
             );
         }
     }
@@ -128,60 +148,62 @@ pub fn lobes<E: Thin>(
 }
 
 /// Real indices `(n where the light arrives from, n where it leaves into)`.
-fn side_indices<E: Thin>(e: &E, towards: Vector3<f64>, component: usize) -> (f64, f64) {
-    let (near, far) = if towards.z > 0.0 {
-        (e.ext(), e.exit())
-    } else {
-        (e.exit(), e.ext())
-    };
+fn side_indices<T: Real, E: Thin<T>>(e: &E, towards: Vector3<T>, component: usize) -> (T, T) {
+    let above = towards.z.gt(T::zero());
+    let (near, far) = (
+        T::select(above, e.ext(), e.exit()),
+        T::select(above, e.exit(), e.ext()),
+    );
     (near, if component == 0 { near } else { far })
 }
 
 /// The direction on the far side of the element that is joined to `w` by transmission (Snell's
-/// law between the two isotropic media; `None` under total internal reflection).
-fn through<E: Thin>(e: &E, w: Vector3<f64>) -> Option<Vector3<f64>> {
+/// law between the two isotropic media), and where it exists (not under total internal
+/// reflection; where it does not, the direction is the grazing one).
+fn through<T: Real, E: Thin<T>>(e: &E, w: Vector3<T>) -> (Vector3<T>, T::Mask) {
     let (n_near, n_far) = side_indices(e, w, 1);
     let ratio = n_near / n_far;
     let sin2 = ratio * ratio * (w.x * w.x + w.y * w.y);
-    if sin2 >= 1.0 {
-        return None;
-    }
-    let cos = (1.0 - sin2).sqrt();
-    Some(Vector3::new(
-        -w.x * ratio,
-        -w.y * ratio,
-        -w.z.signum() * cos,
-    ))
+    let exists = sin2.lt(T::one());
+    let cos = (T::one() - sin2).safe_sqrt();
+    let direction = Vector3::new(-w.x * ratio, -w.y * ratio, cos.copysign(-w.z));
+    (direction, exists)
 }
 
 /// Mueller matrices (s/p frames) of light arriving from `towards` (either side), per channel:
 /// the element (flipped when `towards` is below) solved from above, mirrored back.
-fn physical<E: Thin>(
+fn physical<T: Real, E: Thin<T>>(
     e: &E,
-    spectrum: &Spectrum,
-    towards: Vector3<f64>,
+    spectrum: &E::Spectrum,
+    towards: Vector3<T>,
     want: Want,
-) -> Result<Vec<SlabMueller>> {
-    let flipped;
-    let (e, w, mirrored) = if towards.z > 0.0 {
-        (e, towards, false)
-    } else {
-        flipped = e.flipped();
-        (
-            &flipped,
-            Vector3::new(towards.x, towards.y, -towards.z),
-            true,
-        )
+) -> Result<Vec<SlabMueller<T>>> {
+    let below = towards.z.lt(T::zero());
+    let seen = e.oriented(below);
+    let w = Vector3::new(towards.x, towards.y, towards.z.abs());
+    let beta = cx::real(seen.ext() * (w.x * w.x + w.y * w.y).sqrt());
+    let ms = seen.evaluate(spectrum, PlaneFrame::from_direction(w), beta, want)?;
+    // D M D with D = diag(1, 1, −1, −1): the entries with one index in {2, 3} change sign.
+    let mirror = |m: Option<Matrix4<T>>| {
+        m.map(|m| {
+            if below.known() == Some(false) {
+                return m;
+            }
+            Matrix4::from_fn(|i, j| {
+                let x = m[(i, j)];
+                if (i >= 2) != (j >= 2) {
+                    T::select(below, -x, x)
+                } else {
+                    x
+                }
+            })
+        })
     };
-    let beta = C64::new(e.ext() * (w.x * w.x + w.y * w.y).sqrt(), 0.0);
-    let ms = e.evaluate(spectrum, PlaneFrame::from_direction(w), beta, want)?;
-    let d = Matrix4::from_diagonal(&nalgebra::Vector4::new(1.0, 1.0, -1.0, -1.0));
-    let fix = |m: Option<Matrix4<f64>>| m.map(|m| if mirrored { d * m * d } else { m });
     Ok(ms
         .into_iter()
         .map(|m| SlabMueller {
-            r: fix(m.r),
-            t: fix(m.t),
+            r: mirror(m.r),
+            t: mirror(m.t),
         })
         .collect())
 }
