@@ -6,6 +6,7 @@
 //! `spectrum.bandwidth_nm`.
 
 use crate::error::{Error, Result};
+use crate::real::{Mask, Real};
 
 /// Largest plate thickness (nm): 1 m. Beyond, the phases `k d q` (~1e7 rad per metre at
 /// 550 nm) lose the digits that interference needs.
@@ -59,6 +60,17 @@ impl Thickness {
                 nm / per
             ),
         ))
+    }
+
+    /// [`Thickness::new`] over the reals `T`: the check and its message where the value is
+    /// known; while recording, the lanes where it fails carry no light.
+    pub fn checked<T: Real>(name: &str, nm: T, shown_in: Length) -> Result<T> {
+        if let Some(x) = nm.value() {
+            return Thickness::new(name, x, shown_in).map(|_| nm);
+        }
+        let valid = nm.ge(T::zero()) & nm.le(T::cst(THICKNESS_MAX_NM));
+        (!valid).fail(|| Error::new(name, "outside [0, 1 m]"))?;
+        Ok(nm)
     }
 
     /// [`Thickness::new`] of a value given in nanometres under the name `thickness_nm`.

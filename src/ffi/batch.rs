@@ -14,6 +14,7 @@ use super::spectrum::PlateSpectrum;
 use super::tangents::{crystal_inputs, plate_inputs, TangentOutput};
 use crate::error::{Error, Result};
 use crate::material::Material;
+use crate::optics::frame::rotated_about_normal;
 use crate::optics::medium::Uniaxial;
 use crate::optics::surface::Surface;
 use crate::params::{Length, Thickness};
@@ -379,9 +380,9 @@ impl<'a> CrystalColumns<'a> {
     }
 }
 
-/// `axis` rotated about the local normal (z) by `degrees`, counter-clockwise seen from +z (from
-/// the tangent s towards t): the plugin's `axis_angle`, which must be finite.
-pub(super) fn rotated_about_normal(axis: Vector3<f64>, degrees: f64) -> Result<Vector3<f64>> {
+/// `axis` rotated about the local normal by `degrees` ([`rotated_about_normal`]), which must be
+/// finite (the plugin's `axis_angle`).
+pub(super) fn rotated_about(axis: Vector3<f64>, degrees: f64) -> Result<Vector3<f64>> {
     if !degrees.is_finite() {
         return Err(Error::new(
             "axis_angle",
@@ -391,12 +392,7 @@ pub(super) fn rotated_about_normal(axis: Vector3<f64>, degrees: f64) -> Result<V
     if degrees == 0.0 {
         return Ok(axis);
     }
-    let (s, c) = degrees.to_radians().sin_cos();
-    Ok(Vector3::new(
-        c * axis.x - s * axis.y,
-        s * axis.x + c * axis.y,
-        axis.z,
-    ))
+    Ok(rotated_about_normal(axis, degrees))
 }
 
 /// True if component `k` is enabled in the bit set `components`.
@@ -433,7 +429,7 @@ fn plate_at(
         p.birefringence,
         C64::new(c.ext_ior.at(i), 0.0),
         C64::new(cols.exit_ior.at(i), 0.0),
-        rotated_about_normal(p.axis, p.axis_angle_deg)?,
+        rotated_about(p.axis, p.axis_angle_deg)?,
         Thickness::new("thickness", p.thickness_nm, Length::Micrometres)?,
         enabled(call.components, 0),
         enabled(call.components, 1),

@@ -17,6 +17,7 @@ mod batch;
 mod columns;
 mod guard;
 mod materials;
+mod programs;
 mod samples;
 mod spectrum;
 mod stack;
@@ -24,6 +25,7 @@ mod tangents;
 
 pub use batch::{sample_crystal, sample_crystal_tangents, sample_plate, sample_plate_tangents};
 pub use materials::{new_materials, Materials};
+pub use programs::{record_plate, Program};
 pub use spectrum::{
     band_spectrum, channels_to_linear_srgb, colour_channel_spectrum, colour_channel_wavelength,
     default_channel, exact_spectrum, srgb_spectrum, PlateSpectrum,
@@ -253,6 +255,139 @@ pub mod bridge {
         wo: [&'a mut [f64]; 3],
         /// Derivatives of the sample weight, per channel, in Mitsuba's implicit frames.
         value: [&'a mut [f64]; 16],
+    }
+
+    /// An operation of a recorded program (`crate::record::Op`, in the same order): numbers
+    /// are Dr.Jit floats, masks Dr.Jit masks.
+    #[repr(u8)]
+    #[derive(Debug)]
+    enum Op {
+        Const = 0,
+        Input,
+        Neg,
+        Add,
+        Sub,
+        Mul,
+        Div,
+        Sqrt,
+        SafeSqrt,
+        Sin,
+        Cos,
+        Exp,
+        Abs,
+        Min,
+        Max,
+        CopySign,
+        Detach,
+        Select,
+        Lt,
+        Le,
+        Eq,
+        Finite,
+        And,
+        Or,
+        Not,
+        Flag,
+    }
+
+    /// One instruction of a recorded program: its result is value number `i`, its position.
+    /// Operands are earlier value numbers (`a` is the input's index for `Input`); `value` is
+    /// the constant of `Const` and `Flag` (nonzero: true).
+    #[derive(Debug)]
+    struct Instr {
+        op: Op,
+        a: u32,
+        b: u32,
+        c: u32,
+        value: f64,
+    }
+
+    /// The inputs of a plate's program, by index. The texture values and the path's are
+    /// always read; the material's and the axis only where the recipe makes them inputs
+    /// (otherwise the recipe's values are constants of the program).
+    #[repr(u32)]
+    #[derive(Debug)]
+    enum PlateInput {
+        /// Mitsuba's si.wi (local frame).
+        WiX = 0,
+        WiY = 1,
+        WiZ = 2,
+        /// The lobe-choosing uniform number.
+        Sample = 3,
+        /// The thickness texture's value (um, before thickness_scale).
+        Thickness = 4,
+        /// The birefringence texture's value (before birefringence_scale; 0 without one).
+        Birefringence = 5,
+        /// The axis_angle texture's value (degrees; 0 without one).
+        AxisAngle = 6,
+        /// optic_axis (where `axis_is_input`).
+        AxisX = 7,
+        AxisY = 8,
+        AxisZ = 9,
+        /// Re eta_o, Re eta_e of constant indices (where `indices_are_inputs`).
+        EtaO = 10,
+        EtaE = 11,
+        /// kappa_o, kappa_e (where `kappas_are_inputs`).
+        KappaO = 12,
+        KappaE = 13,
+        /// The first of `channels` wavelengths (nm).
+        Wavelength0 = 14,
+    }
+
+    /// The outputs of a sample program, by index: the mask `Valid` (a lobe was sampled), then
+    /// numbers; per channel `c` (always 4, a query of fewer repeating its last) at
+    /// `Channel0 + PerChannel c`: the in and out Stokes x axes (3 + 3), then the Mueller matrix
+    /// over the pdf, row-major (16). After `Count` outputs, one more: the mask of the lanes
+    /// that could not be computed (an invalid texture value), which carry no light.
+    #[repr(u32)]
+    #[derive(Debug)]
+    enum SampleOutput {
+        Valid = 0,
+        Slot = 1,
+        Component = 2,
+        Pdf = 3,
+        Eta = 4,
+        WoX = 5,
+        WoY = 6,
+        WoZ = 7,
+        Channel0 = 8,
+        PerChannel = 22,
+        Count = 96,
+    }
+
+    /// What a plate's program is recorded for: the query's settings and the plugin's
+    /// parameters (which of them are inputs, the others' values as constants).
+    #[derive(Debug)]
+    struct PlateRecipe {
+        material: u32,
+        transport: Transport,
+        components: u32,
+        channels: u32,
+        intensity_only: bool,
+        absorbing_exit: bool,
+        ext_ior: f64,
+        exit_ior: f64,
+        thickness_scale: f64,
+        birefringence_scale: f64,
+        optic_axis: [f64; 3],
+        axis_is_input: bool,
+        indices_are_inputs: bool,
+        kappas_are_inputs: bool,
+    }
+
+    extern "Rust" {
+        /// A recorded program (`crate::record::Program`).
+        type Program;
+        /// Records the sample of a plate over `recipe.channels` exact wavelengths.
+        fn record_plate(materials: &Materials, recipe: &PlateRecipe) -> Result<Box<Program>>;
+        /// The instructions, operands before their uses.
+        fn instructions(self: &Program) -> &[Instr];
+        /// The value numbers of the outputs, in `SampleOutput` order, then the failure mask.
+        fn outputs(self: &Program) -> &[u32];
+        /// How many inputs it reads.
+        fn inputs(self: &Program) -> usize;
+        /// Instructions other than constants and inputs.
+        fn operations(self: &Program) -> usize;
     }
 
     extern "Rust" {

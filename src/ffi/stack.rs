@@ -3,7 +3,7 @@
 //! written to the outputs. Panics are caught per lane.
 
 use super::batch::{
-    choose_thin, enabled, finish, rotated_about_normal, transport_and_sample, write_lanes, Lobes,
+    choose_thin, enabled, finish, rotated_about, transport_and_sample, write_lanes, Lobes,
 };
 use super::bridge::{PlateCall, Samples, StackLanes, Status, Transport as BridgeTransport};
 use super::columns::{Column, Columns3, Wavelengths};
@@ -115,7 +115,7 @@ fn stack_lane(
                 Layer::new(
                     *materials.get(cols.material[k])?,
                     cols.birefringence[k].at(i),
-                    rotated_about_normal(cols.optic_axis.at(k), cols.axis_angle_deg[k].at(i))?,
+                    rotated_about(cols.optic_axis.at(k), cols.axis_angle_deg[k].at(i))?,
                     Thickness::new("thickness", cols.thickness_nm[k].at(i), Length::Micrometres)?,
                 )
             };

@@ -143,6 +143,12 @@ impl Dispersion {
     }
 }
 
+/// `x^p` for a small integer `p`, by repeated multiplication (what `powi` does).
+fn powi<T: Real>(x: T, p: i32) -> T {
+    let base = if p < 0 { x.recip() } else { x };
+    (0..p.unsigned_abs()).fold(T::one(), |acc, _| acc * base)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -214,10 +220,4 @@ mod tests {
         assert_eq!(Dispersion::Constant(f64::NAN).index(500.0), 1.0);
         assert_eq!(Dispersion::Constant(-1.0).try_index(500.0), None);
     }
-}
-
-/// `x^p` for a small integer `p`, by repeated multiplication (what `powi` does).
-fn powi<T: Real>(x: T, p: i32) -> T {
-    let base = if p < 0 { x.recip() } else { x };
-    (0..p.unsigned_abs()).fold(T::one(), |acc, _| acc * base)
 }

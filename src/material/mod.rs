@@ -86,6 +86,11 @@ pub struct Material<T: Real = f64> {
 }
 
 impl<T: Real> Material<T> {
+    /// True if any index varies with wavelength.
+    pub fn is_dispersive(&self) -> bool {
+        self.eta_o.is_dispersive() || self.eta_e.is_dispersive()
+    }
+
     /// `(η_o, η_e)` at `lambda_nm`, with `birefringence` added to `Re η_e` (photoelastic
     /// stress: `n_e − n_o = C (σ₁ − σ₂)` on an isotropic material). Fails (naming the
     /// parameter) if the result is not a valid index; while recording, such lanes fail.
@@ -137,11 +142,6 @@ impl Material {
             eta_o: index(false, kappa_o),
             eta_e: index(true, kappa_e),
         })
-    }
-
-    /// True if any index varies with wavelength.
-    pub fn is_dispersive(&self) -> bool {
-        self.eta_o.is_dispersive() || self.eta_e.is_dispersive()
     }
 
     /// True if the material is isotropic at every wavelength: equal constant indices (named
@@ -253,10 +253,7 @@ pub fn checked_index<T: Real>(parameter: &str, eta: Cx<T>) -> Result<Cx<T>> {
         return Ok(eta);
     }
     let (lo, hi) = (T::cst(INDEX_RANGE.0), T::cst(INDEX_RANGE.1));
-    let valid = eta.re.ge(lo)
-        & eta.re.le(hi)
-        & eta.im.ge(T::zero())
-        & eta.im.le(T::cst(KAPPA_MAX));
+    let valid = eta.re.ge(lo) & eta.re.le(hi) & eta.im.ge(T::zero()) & eta.im.le(T::cst(KAPPA_MAX));
     (!valid).fail(|| Error::new(parameter, "not a valid index"))?;
     Ok(eta)
 }

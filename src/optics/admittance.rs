@@ -224,13 +224,9 @@ fn solve2<R: Real, T: Scalar<R>>(l: &[[T; 2]; 2], b: &Pair<T>) -> Result<Pair<T>
     let m = row(bottom, 0) * inv0;
     let p1 = pivot(row(bottom, 1) - m * row(top, 1), scale)?;
     let inv1 = p1.inverse();
-    let mut x = [[T::zero(); 4]; 2];
-    for col in 0..4 {
-        let x1 = (rhs(bottom, col) - m * rhs(top, col)) * inv1;
-        x[1][col] = x1;
-        x[0][col] = (rhs(top, col) - row(top, 1) * x1) * inv0;
-    }
-    Ok(x)
+    let x1: [T; 4] = std::array::from_fn(|col| (rhs(bottom, col) - m * rhs(top, col)) * inv1);
+    let x0 = std::array::from_fn(|col| (rhs(top, col) - row(top, 1) * x1[col]) * inv0);
+    Ok([x0, x1])
 }
 
 /// `pivot`, or the singular error where it is too small to divide by (or NaN) relative to

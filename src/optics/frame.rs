@@ -31,10 +31,7 @@ impl<T: Real> PlaneFrame<T> {
         let (x, y) = (-towards_light.x, -towards_light.y);
         let n = (x * x + y * y).sqrt();
         let zero = T::zero();
-        let (ux, uy) = n.gt(zero).when(
-            || (x / n, y / n),
-            || (zero, T::cst(-1.0)),
-        );
+        let (ux, uy) = n.gt(zero).when(|| (x / n, y / n), || (zero, T::cst(-1.0)));
         Self::from_u(Vector3::new(ux, uy, zero))
     }
 
@@ -55,6 +52,14 @@ impl<T: Real> PlaneFrame<T> {
     pub fn to_local(&self, v: Vector3<T>) -> Vector3<T> {
         self.u * v.x + self.s * v.y + Vector3::new(T::zero(), T::zero(), v.z)
     }
+}
+
+/// `axis` rotated about the local normal (z) by `degrees`, counter-clockwise seen from +z (from
+/// the tangent s towards t): the plugins' `axis_angle`.
+pub fn rotated_about_normal<T: Real>(axis: Vector3<T>, degrees: T) -> Vector3<T> {
+    // As `f64::to_radians`: `degrees · (π / 180)`.
+    let (s, c) = (degrees * (std::f64::consts::PI / 180.0)).sin_cos();
+    Vector3::new(c * axis.x - s * axis.y, s * axis.x + c * axis.y, axis.z)
 }
 
 #[cfg(test)]

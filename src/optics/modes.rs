@@ -324,8 +324,10 @@ pub fn uniaxial_modes<T: Real>(medium: &Uniaxial<T>, beta: Cx<T>) -> ModeSet<T> 
     // The e-wave's exact flux: a lossless medium at real β (known per medium), where the
     // e-wave propagates (w real).
     let lossless = real_coefficients(medium, beta);
-    let ek_z =
-        (!lossless.known().is_some_and(|l| !l)).then(|| (lossless & w.im.equals(T::zero()), w.re));
+    let ek_z = lossless
+        .known()
+        .is_none_or(|l| l)
+        .then(|| (lossless & w.im.equals(T::zero()), w.re));
     let real_fields = lossless
         & w.im.equals(T::zero())
         & qo_squared.im.equals(T::zero())

@@ -364,7 +364,6 @@ impl<T: Real> SlabBlocks<T> {
 }
 
 impl SlabBlocks {
-
     /// All values as one array (blocks row by row, then `q`, then the flux).
     pub fn values(&self) -> [C64; BLOCK_VALUES] {
         let mut v = [C64::new(0.0, 0.0); BLOCK_VALUES];
@@ -424,10 +423,12 @@ pub enum Output {
 
 impl Output {
     /// `m` as this output asks: unchanged, or only `M00` (the other entries zero).
-    pub fn keep(self, m: SlabMueller) -> SlabMueller {
-        let cut = |m: Matrix4<f64>| match self {
+    pub fn keep<T: Real>(self, m: SlabMueller<T>) -> SlabMueller<T> {
+        let cut = |m: Matrix4<T>| match self {
             Output::Mueller => m,
-            Output::Intensity => Matrix4::from_fn(|i, j| if i + j == 0 { m[(0, 0)] } else { 0.0 }),
+            Output::Intensity => {
+                Matrix4::from_fn(|i, j| if i + j == 0 { m[(0, 0)] } else { T::zero() })
+            }
         };
         SlabMueller {
             r: m.r.map(cut),

@@ -19,9 +19,11 @@
 //! its weight (the single-lobe convention of Mitsuba's own BSDFs: the sample's value is then
 //! the lobe itself, the form `eval_null_transmission` needs).
 
+use crate::real::{Mask, Real, Select};
 use crate::render::slots::Slots;
 #[cfg(doc)]
 use crate::render::PathLobe;
+use nalgebra::{Matrix4, Vector3};
 
 /// The chosen slot.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -42,44 +44,155 @@ pub fn choose<const S: usize>(
     enabled: impl Fn(usize) -> bool,
     u: f64,
 ) -> Option<Choice> {
-    // Each candidate's weight summed over the channels; `None` for the other slots.
-    let weight: [Option<f64>; S] = std::array::from_fn(|slot| {
-        let lobes = channels.iter().filter_map(|c| c[slot].as_ref());
-        (enabled(slot) && lobes.clone().next().is_some())
-            .then(|| lobes.map(|l| l.power.abs()).sum())
-    });
-    let chosen = |slot: usize, pdf: f64| Choice {
+    let (chosen, pdf, valid) = walk(&candidates(channels, &enabled), u);
+    let slot = chosen.iter().position(|&c| c)?;
+    valid.then(|| Choice {
         slot,
         pdf,
-        hero: channels.iter().position(|c| c[slot].is_some()).unwrap_or(0),
-    };
-    let mut candidates = weight
-        .iter()
-        .enumerate()
-        .filter_map(|(s, w)| w.map(|w| (s, w)));
-    let first = candidates.next()?;
-    if candidates.next().is_none() {
-        return Some(chosen(first.0, 1.0));
-    }
-    let total: f64 = weight.iter().flatten().sum();
-    if total.is_nan() || total <= 0.0 {
-        return None;
-    }
-    // The last slot with weight catches u * total == total (rounding).
-    let (target, mut acc, mut pick) = (u * total, 0.0, None);
-    for (slot, w) in weight.iter().enumerate() {
-        match *w {
-            Some(w) if w > 0.0 => {
-                pick = Some((slot, w));
-                acc += w;
-                if target < acc {
-                    break;
-                }
+        hero: channels
+            .iter()
+            .position(|c| c[slot].is_some_and(|l| l.exists))
+            .unwrap_or(0),
+    })
+}
+
+/// Each slot's candidacy (enabled, and existing in a channel) and weight (`|power|` summed
+/// over the channels that have it).
+fn candidates<T: Real, const S: usize>(
+    channels: &[Slots<S, T>],
+    enabled: &impl Fn(usize) -> bool,
+) -> [(T::Mask, T); S] {
+    std::array::from_fn(|slot| {
+        let mut candidate = T::Mask::cst(false);
+        let mut weight = T::zero();
+        if enabled(slot) {
+            for l in channels.iter().filter_map(|c| c[slot].as_ref()) {
+                candidate = candidate | l.exists;
+                weight += T::select(l.exists, l.power.abs(), T::zero());
             }
-            _ => {}
+        }
+        (candidate, weight)
+    })
+}
+
+/// The walk of the module docs over slots `(candidate, weight)`: which slot is chosen (one
+/// mask per slot, at most one holding), its probability, and whether one is chosen (a single
+/// candidate always is, with probability 1; several need a positive total weight).
+fn walk<T: Real, const S: usize>(slots: &[(T::Mask, T); S], u: T) -> ([T::Mask; S], T, T::Mask) {
+    let (no, zero, one) = (T::Mask::cst(false), T::zero(), T::one());
+    // The first candidate, and whether there is exactly one.
+    let (mut seen, mut many) = (no, no);
+    let mut first = [no; S];
+    for (f, &(candidate, _)) in first.iter_mut().zip(slots) {
+        many = many | (seen & candidate);
+        *f = candidate & !seen;
+        seen = seen | candidate;
+    }
+    let single = seen & !many;
+    let total = slots
+        .iter()
+        .fold(zero, |acc, &(c, w)| acc + T::select(c, w, zero));
+    // The last slot with weight catches u * total == total (rounding).
+    let target = u * total;
+    let (mut acc, mut done, mut weight) = (zero, no, zero);
+    let mut pick = [no; S];
+    for s in 0..S {
+        let (candidate, w) = slots[s];
+        let positive = candidate & w.gt(zero);
+        acc += T::select(positive, w, zero);
+        let take = !done & positive;
+        for p in pick.iter_mut().take(s) {
+            *p = *p & !take;
+        }
+        pick[s] = take;
+        weight = T::select(take, w, weight);
+        done = done | (positive & target.lt(acc));
+    }
+    let picked = pick.iter().fold(no, |m, &p| m | p);
+    let chosen = std::array::from_fn(|s| (single & first[s]) | (!single & pick[s]));
+    let pdf = T::select(single, one, weight / T::select(picked, total, one));
+    let valid = single | (total.gt(zero) & picked);
+    (chosen, pdf, valid)
+}
+
+/// A chosen lobe as Mitsuba's sample takes it, over the reals `T`: in `C` channels (at most).
+#[derive(Clone, Copy, Debug)]
+pub struct Sampled<T: Real, const C: usize> {
+    /// Where a lobe was chosen.
+    pub valid: T::Mask,
+    /// The chosen slot (as a number).
+    pub slot: T,
+    /// Mitsuba's component of the chosen slot.
+    pub component: T,
+    /// Its selection probability.
+    pub pdf: T,
+    /// The hero channel's `bs.eta`.
+    pub eta: T,
+    /// The hero channel's `wo`.
+    pub wo: Vector3<T>,
+    /// Each channel's frame of the arriving light (the hero's where a channel lacks the lobe).
+    pub in_x: [Vector3<T>; C],
+    /// Each channel's frame of the leaving light.
+    pub out_x: [Vector3<T>; C],
+    /// Each channel's Mueller matrix over the probability (zero where it lacks the lobe).
+    pub value: [Matrix4<T>; C],
+}
+
+/// The lobe a path follows among the slots of `channels` (the walk of [`choose`] with the
+/// uniform number `u`, over the slots `enabled` allows), as Mitsuba's sample: the hero
+/// channel's direction and index ratio, each channel's matrix over the probability.
+pub fn sample<T: Real, const S: usize, const C: usize>(
+    channels: &[Slots<S, T>; C],
+    enabled: impl Fn(usize) -> bool,
+    component: impl Fn(usize) -> usize,
+    u: T,
+) -> Sampled<T, C> {
+    let (chosen, pdf, valid) = walk(&candidates(channels, &enabled), u);
+    let zero = T::zero();
+    let z3 = Vector3::from_element(zero);
+    let mut out = Sampled {
+        valid,
+        slot: zero,
+        component: zero,
+        pdf,
+        eta: zero,
+        wo: z3,
+        in_x: [z3; C],
+        out_x: [z3; C],
+        value: [Matrix4::from_element(zero); C],
+    };
+    // The hero: the first channel that has the slot; later channels choose in reverse order.
+    for (s, &picked) in chosen.iter().enumerate() {
+        if picked.known() == Some(false) {
+            continue;
+        }
+        out.slot = T::select(picked, T::cst(s as f64), out.slot);
+        out.component = T::select(picked, T::cst(component(s) as f64), out.component);
+        for lobe in channels.iter().rev().filter_map(|c| c[s].as_ref()) {
+            let hero = picked & lobe.exists;
+            out.wo = Select::select(hero, lobe.wo, out.wo);
+            out.eta = T::select(hero, lobe.eta, out.eta);
+            for c in 0..C {
+                out.in_x[c] = Select::select(hero, lobe.in_stokes_x, out.in_x[c]);
+                out.out_x[c] = Select::select(hero, lobe.out_stokes_x, out.out_x[c]);
+            }
         }
     }
-    pick.map(|(slot, w)| chosen(slot, w / total))
+    // Lanes without a lobe divide by one (their numbers are finite, and so their derivatives).
+    let safe_pdf = T::select(valid, pdf, T::one());
+    for (s, &picked) in chosen.iter().enumerate() {
+        if picked.known() == Some(false) {
+            continue;
+        }
+        for (c, slots) in channels.iter().enumerate() {
+            let Some(lobe) = &slots[s] else { continue };
+            let own = picked & lobe.exists;
+            out.in_x[c] = Select::select(own, lobe.in_stokes_x, out.in_x[c]);
+            out.out_x[c] = Select::select(own, lobe.out_stokes_x, out.out_x[c]);
+            out.value[c] = Select::select(own, lobe.mueller / safe_pdf, out.value[c]);
+        }
+    }
+    out
 }
 
 #[cfg(test)]

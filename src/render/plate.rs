@@ -11,6 +11,10 @@ use crate::optics::medium::Uniaxial;
 use crate::params::{Bandwidth, Thickness};
 use crate::plate::slab::{Output, SlabMueller, Want};
 use crate::plate::Plate;
+use crate::real::complex::Cx;
+use crate::real::{Real, Select};
+use crate::render::choice::{self, Sampled};
+use crate::render::slots::{plate_component, Slots, PLATE_SLOTS};
 use crate::render::thin::{self, Thin};
 use crate::render::{PathLobe, Transport};
 use crate::spectral::model::{Accuracy, PlateModel};
@@ -207,7 +211,7 @@ impl Thin for PlateQuery {
         if below {
             self.flipped()
         } else {
-            self.clone()
+            *self
         }
     }
 
@@ -277,4 +281,126 @@ fn evaluate(
                 .collect()
         }
     }
+}
+
+/// A plate query at exact wavelengths, over the reals `T`: what a spectral renderer asks at the
+/// wavelengths it traces along a path, on the host (`f64`) or recorded as a program
+/// ([`crate::record`]) whose inputs are the path's and the plate's per-lane values.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ExactPlate<T: Real = f64> {
+    /// The plate (top = the exterior side, `z > 0`).
+    pub plate: Plate<T>,
+    /// Which lobes to compute.
+    pub want: Want,
+    /// Only `M00`.
+    pub output: Output,
+    /// The exit medium absorbs whatever enters it ([`PlateQuery::absorbing_exit`]).
+    pub absorbing_exit: bool,
+}
+
+impl ExactPlate {
+    /// The exact plate of a validated query.
+    pub fn of(q: &PlateQuery) -> Self {
+        ExactPlate {
+            plate: q.plate,
+            want: q.want,
+            output: q.output,
+            absorbing_exit: q.absorbing_exit,
+        }
+    }
+}
+
+impl<T: Real> Thin<T> for ExactPlate<T> {
+    type Spectrum = [T];
+
+    fn channels(wavelengths: &[T]) -> Result<usize> {
+        if (1..=MAX_BANDS).contains(&wavelengths.len()) {
+            Ok(wavelengths.len())
+        } else {
+            Err(Error::new(
+                "count",
+                format!(
+                    "must be 1 to {MAX_BANDS} wavelengths, got {}",
+                    wavelengths.len()
+                ),
+            ))
+        }
+    }
+
+    fn is_signed(_: &[T]) -> bool {
+        false
+    }
+
+    fn want(&self) -> Want {
+        self.want
+    }
+
+    fn output(&self) -> Output {
+        self.output
+    }
+
+    fn absorbing_exit(&self) -> bool {
+        self.absorbing_exit
+    }
+
+    fn ext(&self) -> T {
+        self.plate.ext.re
+    }
+
+    fn exit(&self) -> T {
+        self.plate.exit.re
+    }
+
+    fn oriented(&self, below: T::Mask) -> Self {
+        let p = &self.plate;
+        let mut q = *self;
+        q.plate.ext = Select::select(below, p.exit, p.ext);
+        q.plate.exit = Select::select(below, p.ext, p.exit);
+        q.plate.axis.z = T::select(below, -p.axis.z, p.axis.z);
+        q
+    }
+
+    /// The slab at each wavelength; a plate whose indices do not depend on the wavelength
+    /// solves its interfaces once.
+    fn evaluate(
+        &self,
+        wavelengths: &[T],
+        frame: PlaneFrame<T>,
+        beta: Cx<T>,
+        want: Want,
+    ) -> Result<Vec<SlabMueller<T>>> {
+        let mut fixed = None;
+        let mut out = Vec::with_capacity(wavelengths.len());
+        for &lambda_nm in wavelengths {
+            let slab = self.plate.at(lambda_nm)?;
+            let optics = match fixed {
+                Some(o) if !self.plate.material.is_dispersive() => o,
+                _ => slab.optics(&frame, beta)?,
+            };
+            fixed = Some(optics);
+            out.push(self.output.keep(optics.mueller(lambda_nm, want)?));
+        }
+        Ok(out)
+    }
+}
+
+/// The lobe a path samples from an exact plate (one wavelength per channel) seen from `wi`,
+/// chosen with the uniform number `u` among the components whose bits `components` sets
+/// (0 reflection, 1 transmission), as Mitsuba's sample ([`choice::sample`]).
+pub fn sample_exact<T: Real, const C: usize>(
+    q: &ExactPlate<T>,
+    wavelengths: &[T; C],
+    wi: Vector3<T>,
+    u: T,
+    transport: Transport,
+    components: u32,
+) -> Result<Sampled<T, C>> {
+    let per_channel = thin::lobes(q, &wavelengths[..], wi, transport, true)?;
+    let slots: [Slots<PLATE_SLOTS, T>; C] = std::array::from_fn(|c| per_channel[c]);
+    Ok(choice::sample(
+        &slots,
+        |slot| components & (1 << plate_component(slot)) != 0,
+        plate_component,
+        u,
+    ))
 }

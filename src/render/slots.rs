@@ -21,8 +21,8 @@ pub const PLATE_SLOTS: usize = 2;
 /// Slots of a crystal query.
 pub const CRYSTAL_SLOTS: usize = 9;
 
-/// The lobes of one query (one wavelength or channel) by slot.
-pub type Slots<const S: usize> = [Option<PathLobe>; S];
+/// The lobes of one query (one wavelength or channel) by slot, over the reals `T`.
+pub type Slots<const S: usize, T = f64> = [Option<PathLobe<T>>; S];
 
 /// One end of a crystal lobe: `None` for the exterior wave, else the crystal ray's mode
 /// (s/p waves of an isotropic crystal count as o).

@@ -15,7 +15,7 @@ use crate::optics::frame::PlaneFrame;
 use crate::optics::mueller::reversed;
 use crate::plate::slab::{Output, SlabMueller, Want};
 use crate::real::complex::{self as cx, Cx};
-use crate::real::{Mask, Real, Select};
+use crate::real::{Mask, Real};
 use crate::render::{PathLobe, Transport};
 use nalgebra::{Matrix4, Vector3};
 
