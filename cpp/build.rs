@@ -121,17 +121,6 @@ fn main() {
     ] {
         println!("cargo:rustc-cdylib-link-arg={arg}");
     }
-    for f in sources.iter().chain(&[
-        "src/register.h",
-        "src/plugins.h",
-        "src/params.h",
-        "src/bridge.h",
-        "src/lobes.h",
-        "src/last_valid.h",
-        "src/scalar_texture.h",
-        "src/signed_rgb.h",
-        "src/layer.h",
-    ]) {
-        println!("cargo:rerun-if-changed={f}");
-    }
+    // Every source and header of the shim (cargo scans the directory).
+    println!("cargo:rerun-if-changed=src");
 }

@@ -150,7 +150,9 @@ impl Lane {
             ext_ior: self.ext,
             exit_ior: self.exit,
             thickness_scale: self.thickness_scale,
+            has_birefringence: self.birefringence != 0.0,
             birefringence_scale: 1.0,
+            has_axis_angle: self.angle_deg != 0.0,
             optic_axis: self.axis.into(),
             axis_is_input: self.inputs.0,
             indices_are_inputs: self.inputs.1,
@@ -337,4 +339,47 @@ fn the_generic_sample_equals_the_scalar_route() {
         compared += 1;
     }
     assert!(compared > 700, "{compared} lanes compared");
+}
+
+/// Prints the size of typical programs (run with --nocapture).
+#[test]
+fn program_sizes() {
+    let mut materials = new_materials();
+    for (name, m) in [
+        ("quartz", materials.add_named("quartz", 0.0, 0.0).unwrap()),
+        ("glass", materials.add_constant(1.5, 1.5, 0.0, 0.0).unwrap()),
+        ("aniso const", materials.add_constant(1.5, 1.6, 0.0, 0.0).unwrap()),
+    ] {
+        for inputs in [false, true] {
+            let recipe = PlateRecipe {
+                material: m,
+                transport: T::Radiance,
+                components: 3,
+                channels: 4,
+                intensity_only: false,
+                absorbing_exit: false,
+                ext_ior: 1.0,
+                exit_ior: 1.0,
+                thickness_scale: 1.0,
+                has_birefringence: false,
+                birefringence_scale: 1.0,
+                has_axis_angle: false,
+                optic_axis: [1.0, 1.0, 0.0],
+                axis_is_input: inputs,
+                indices_are_inputs: inputs,
+                kappas_are_inputs: inputs,
+            };
+            let p = record_plate(&materials, &recipe).unwrap();
+            println!(
+                "{name} inputs {inputs}: {} operations, {} instructions",
+                p.operations(),
+                p.instructions().len()
+            );
+            let mut hist = std::collections::BTreeMap::new();
+            for i in &p.recorded().instrs {
+                *hist.entry(format!("{:?}", i.op)).or_insert(0) += 1;
+            }
+            println!("    {hist:?}");
+        }
+    }
 }

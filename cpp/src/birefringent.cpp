@@ -272,7 +272,7 @@ private:
     std::pair<BSDFSample3f, Spectrum> query(const SurfaceInteraction3f &si, TransportMode mode,
                                             uint32_t components, const Float &sample1,
                                             const Mask &active) const {
-        shim::require_evaluated_mode<Float>(ClassName);
+        shim::require_evaluated_mode<Float>(ClassName, "no query of this plugin yet");
         shim::HostInputs<Float> in;
         const shim::PathColumns path = shim::add_path_inputs<Float, Spectrum>(in, si, sample1, active);
         size_t k_axis = 0;

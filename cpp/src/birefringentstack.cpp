@@ -315,7 +315,7 @@ private:
     /** The core's lobe for every lane of `si` (see thinbirefringent.cpp's `query`). */
     Answers query(const SurfaceInteraction3f &si, TransportMode mode, uint32_t components,
                   const Float &sample1, const Mask &active, bool straight) const {
-        shim::require_evaluated_mode<Float>(ClassName);
+        shim::require_evaluated_mode<Float>(ClassName, "no query of this plugin yet");
         shim::HostInputs<Float, Inputs> in;
         const shim::PathColumns path = shim::add_path_inputs<Float, Spectrum>(in, si, sample1, active);
         const size_t n_layers = m_sources.size();

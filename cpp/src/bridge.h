@@ -43,16 +43,18 @@ constexpr size_t MaxInputs = 16;
 
 /// Throws, in a JIT variant, if the call is being recorded (symbolic loops or calls): the
 /// core needs the lanes' values, which a symbolic variable does not have.
-template <typename Float> void require_evaluated_mode(const char *ClassName) {
+template <typename Float>
+void require_evaluated_mode(const char *ClassName, const char *recorded_where) {
     if constexpr (dr::is_jit_v<Float>) {
         if (jit_flag(JitFlag::SymbolicScope))
-            Throw("this BSDF computes its lobes outside Dr.Jit and works in evaluated mode only, "
+            Throw("this query of the BSDF computes its lobes outside Dr.Jit (it runs inside "
+                  "Mitsuba's kernels only for %s) and works in evaluated mode only, "
                   "but it is being called inside a symbolic loop or call: switch off both "
                   "drjit.JitFlag.SymbolicLoops and drjit.JitFlag.SymbolicCalls, e.g. render inside "
                   "`with mitsuba_birefringent.evaluated_mode():`. While any instance of this BSDF "
                   "exists, symbolic renders of other scenes in this process fail too (Dr.Jit traces "
                   "every registered BSDF): first delete every scene holding one (an exception from "
-                  "a failed render holds its scene too) and collect garbage.");
+                  "a failed render holds its scene too) and collect garbage.", recorded_where);
     }
 }
 

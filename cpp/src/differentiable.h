@@ -52,6 +52,9 @@ public:
             m_kappa_o = Float((float) m.kappa_o);
             m_kappa_e = Float((float) m.kappa_e);
             m_axis = Vector3f(a);
+            // Held in memory, not literals: a program that reads them as inputs (when they
+            // carry derivatives) then runs one kernel whatever their values.
+            dr::make_opaque(m_eta_o, m_eta_e, m_kappa_o, m_kappa_e, m_axis);
         }
         commit(m, a);
     }

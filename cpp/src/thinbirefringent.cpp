@@ -151,6 +151,7 @@ evaluated with ``eval_1`` at the hit point (use ``raw="true"`` for data bitmaps)
 */
 #include "plugins.h"
 #include "differentiable.h"
+#include "recorded.h"
 #include "last_valid.h"
 #include "layer.h"
 #include "scalar_texture.h"
@@ -258,6 +259,7 @@ private:
                          m_components, m_flags);
         check_at_load(axis);
         m_diff.commit(material, axis);
+        m_programs.clear();
         warn_of_units();
     }
 
@@ -271,6 +273,9 @@ public:
                               (ctx.is_enabled(m_types[1], 1) ? 2u : 0u);
         if (!components || shim::none_active(active))
             return { dr::zeros<BSDFSample3f>(), dr::zeros<Spectrum>() };
+        if constexpr (Recordable)
+            if (m_filter_bandwidth == 0.0)
+                return replayed(si, ctx.mode, components, sample1, active, false);
         return query(si, ctx.mode, components, sample1, active, false).sample();
     }
 
@@ -289,6 +294,9 @@ public:
         MI_MASKED_FUNCTION(ProfilerPhase::BSDFEvaluate, active);
         if (!m_null || shim::none_active(active))
             return dr::zeros<Spectrum>();
+        if constexpr (Recordable)
+            if (m_filter_bandwidth == 0.0)
+                return replayed(si, TransportMode::Radiance, 2u, Float(0.5f), active, true).second;
         return query(si, TransportMode::Radiance, 2u, Float(0.5f), active, true).spectrum();
     }
 
@@ -402,7 +410,7 @@ private:
      * are reported once. */
     Answers query(const SurfaceInteraction3f &si, TransportMode mode, uint32_t components,
                   const Float &sample1, const Mask &active, bool straight) const {
-        shim::require_evaluated_mode<Float>(ClassName);
+        shim::require_evaluated_mode<Float>(ClassName, "filter_bandwidth = 0 in a spectral variant");
         shim::HostInputs<Float> in;
         const shim::PathColumns path = shim::add_path_inputs<Float, Spectrum>(in, si, sample1, active);
         Float thickness = m_thickness->eval_1(si, active);
@@ -476,6 +484,79 @@ private:
         return answers;
     }
 
+    /// The variants where a query can be the exact plate at each sampled wavelength, which the
+    /// core records as a program replayed inside Mitsuba's kernels (the JIT spectral variants,
+    /// with filter_bandwidth 0); the other JIT queries (a band, colour channels) call the core
+    /// on the host in evaluated mode.
+    static constexpr bool Recordable = dr::is_jit_v<Float> && is_spectral_v<Spectrum>;
+
+    /// Which parameters are inputs of a program (they carry derivatives: their values may
+    /// change without a new program), the key of a program with the transport mode and the
+    /// enabled components.
+    using ProgramKey = std::tuple<bool, uint32_t, bool, bool, bool>;
+
+    /// The sample of the program of this setting, replayed on the lanes of `si` (recorded.h).
+    std::pair<BSDFSample3f, Spectrum> replayed(const SurfaceInteraction3f &si,
+                                               TransportMode mode, uint32_t components,
+                                               const Float &sample1, const Mask &active,
+                                               bool straight) const {
+        using In = bfr::PlateInput;
+        using Answer = shim::Replayed<Float, Spectrum>;
+        constexpr size_t Channels = Answer::Channels;
+        bool radiance = mode == TransportMode::Radiance;
+        Float eta_o = m_diff.eta_o(), eta_e = m_diff.eta_e(), kappa_o = m_diff.kappa_o(),
+              kappa_e = m_diff.kappa_e();
+        Vector3f axis = m_diff.optic_axis();
+        bool axis_input = dr::grad_enabled(axis);
+        bool indices_input = !m_diff.material.named && dr::grad_enabled(eta_o, eta_e);
+        bool kappas_input = dr::grad_enabled(kappa_o, kappa_e);
+        ProgramKey key{ radiance, components, axis_input, indices_input, kappas_input };
+        const bfr::Program &program = m_programs.get(key, [&] {
+            const ScalarVector3f &a = m_diff.axis;
+            bfr::PlateRecipe recipe{ 0,
+                                     radiance ? bfr::Transport::Radiance
+                                              : bfr::Transport::Importance,
+                                     components,
+                                     (uint32_t) Channels,
+                                     !is_polarized_v<Spectrum>,
+                                     m_absorbing_exit,
+                                     m_ext_ior,
+                                     m_exit_ior,
+                                     m_thickness_scale,
+                                     (bool) m_birefringence,
+                                     m_birefringence_scale,
+                                     (bool) m_axis_angle,
+                                     { a.x(), a.y(), a.z() },
+                                     axis_input,
+                                     indices_input,
+                                     kappas_input };
+            return shim::core_call(ClassName, [&] { return bfr::record_plate(*m_material, recipe); });
+        });
+        std::vector<Float> x((size_t) In::Wavelength0 + Channels, Float(0.f));
+        auto set = [&](In k, const Float &v) { x[(size_t) k] = v; };
+        set(In::WiX, si.wi.x());
+        set(In::WiY, si.wi.y());
+        set(In::WiZ, si.wi.z());
+        set(In::Sample, sample1);
+        set(In::Thickness, m_thickness->eval_1(si, active));
+        if (m_birefringence)
+            set(In::Birefringence, m_birefringence->eval_1(si, active));
+        if (m_axis_angle)
+            set(In::AxisAngle, m_axis_angle->eval_1(si, active));
+        set(In::AxisX, axis.x());
+        set(In::AxisY, axis.y());
+        set(In::AxisZ, axis.z());
+        set(In::EtaO, eta_o);
+        set(In::EtaE, eta_e);
+        set(In::KappaO, kappa_o);
+        set(In::KappaE, kappa_e);
+        if constexpr (is_spectral_v<Spectrum>)
+            for (size_t c = 0; c < Channels; ++c)
+                x[(size_t) In::Wavelength0 + c] = si.wavelengths[c];
+        shim::Replay<Float> r(program, x);
+        return Answer::sample(r, si.wi, radiance, straight, m_types, 2, active);
+    }
+
     /// The inputs of a query that carry gradients (the texture values at the hit, the
     /// handles of the scalar parameters, si.wi), in the core's units.
     shim::TangentInputs<Float> tangent_inputs(const SurfaceInteraction3f &si,
@@ -523,6 +604,8 @@ private:
     /// See signed_rgb.h (the JIT variants' films do not warn of negative values).
     shim::SignedRgbGuard m_signed_rgb { is_rgb_v<Spectrum> && !dr::is_jit_v<Float> };
     std::unique_ptr<shim::Snapshot<Float, Spectrum>> m_valid;  ///< last valid state
+    /// The programs of the JIT spectral variants (recorded()), by ProgramKey.
+    mutable shim::Programs<ProgramKey> m_programs;
 
     MI_TRAVERSE_CB(Base, m_thickness, m_birefringence, m_axis_angle)
 };

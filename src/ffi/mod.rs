@@ -316,9 +316,9 @@ pub mod bridge {
         Sample = 3,
         /// The thickness texture's value (um, before thickness_scale).
         Thickness = 4,
-        /// The birefringence texture's value (before birefringence_scale; 0 without one).
+        /// The birefringence texture's value (before birefringence_scale), where it has one.
         Birefringence = 5,
-        /// The axis_angle texture's value (degrees; 0 without one).
+        /// The axis_angle texture's value (degrees), where it has one.
         AxisAngle = 6,
         /// optic_axis (where `axis_is_input`).
         AxisX = 7,
@@ -368,7 +368,11 @@ pub mod bridge {
         ext_ior: f64,
         exit_ior: f64,
         thickness_scale: f64,
+        /// The plate has a `birefringence` texture (else its input is not read).
+        has_birefringence: bool,
         birefringence_scale: f64,
+        /// The plate has an `axis_angle` texture (else its input is not read).
+        has_axis_angle: bool,
         optic_axis: [f64; 3],
         axis_is_input: bool,
         indices_are_inputs: bool,

@@ -124,7 +124,7 @@ pub struct Sampled<T: Real, const C: usize> {
     pub slot: T,
     /// Mitsuba's component of the chosen slot.
     pub component: T,
-    /// Its selection probability.
+    /// Its selection probability (detached: no derivative flows through it).
     pub pdf: T,
     /// The hero channel's `bs.eta`.
     pub eta: T,
@@ -148,6 +148,9 @@ pub fn sample<T: Real, const S: usize, const C: usize>(
     u: T,
 ) -> Sampled<T, C> {
     let (chosen, pdf, valid) = walk(&candidates(channels, &enabled), u);
+    // The probability carries no derivative (as Mitsuba's `dielectric` detaches its Fresnel
+    // choice): the gradient of an attached sample's weight is then that of its lobe.
+    let pdf = pdf.detach();
     let zero = T::zero();
     let z3 = Vector3::from_element(zero);
     let mut out = Sampled {

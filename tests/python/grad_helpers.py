@@ -24,11 +24,23 @@ FLOOR = 1e-4
 
 def moved(params, keys: str, direction, s):
     """Sets each of `params[key]` (keys separated by "+") to its value plus `direction * s` (a
-    Float, Vector3f or TensorXf), then updates once."""
+    Float, Vector3f or TensorXf), then updates once. The new values are opaque (held in memory,
+    as an optimiser's are), so that every step runs the same kernel: a literal value would be
+    compiled into a kernel of its own."""
     for key in keys.split("+"):
         value = params[key]
-        params[key] = type(value)(value) + direction * s
+        new = type(value)(value) + direction * s
+        dr.make_opaque(new)
+        params[key] = new
     params.update()
+
+
+def step(value: float):
+    """The parameter `s` of one evaluation: opaque and carrying gradients (as in the AD
+    evaluations), so that the finite differences run the kernel the derivatives run."""
+    s = dr.opaque(mi.Float, value)
+    dr.enable_grad(s)
+    return s
 
 
 def evaluate(make, s, null: bool = False):
@@ -55,9 +67,9 @@ def derivatives(make, h: float, null: bool = False, seed: int = 7):
     # Finite differences: s = +-h, +-2h, Richardson-extrapolated (error O(h^4)).
     vals = {}
     for k in (-2, -1, 1, 2):
-        w, comp, pdf = evaluate(make, mi.Float(k * h), null)
+        w, comp, pdf = evaluate(make, step(k * h), null)
         vals[k] = (as_numpy(w), comp, pdf)
-    base, comp0, wo0 = evaluate(make, mi.Float(0.0), null)
+    base, comp0, wo0 = evaluate(make, step(0.0), null)
     d1 = (vals[1][0] - vals[-1][0]) / (2 * h)
     d2 = (vals[2][0] - vals[-2][0]) / (4 * h)
     fd = (4 * d1 - d2) / 3
@@ -69,16 +81,14 @@ def derivatives(make, h: float, null: bool = False, seed: int = 7):
             keep &= (vals[k][1] == comp0) & (np.abs(vals[k][2] - wo0).max(axis=0) < 0.05)
     fd = np.where(keep, fd, 0.0)
     # Forward mode.
-    s = mi.Float(0.0)
-    dr.enable_grad(s)
+    s = step(0.0)
     w, _, _ = evaluate(make, s, null)
     dr.forward(s)
     ad = np.where(keep, as_numpy(dr.grad(w)), 0.0)
     # Reverse mode: the gradient of a random projection of the lanes that keep their choice.
     rng = np.random.default_rng(seed)
     r = np.where(keep, rng.normal(size=fd.shape), 0.0)
-    s = mi.Float(0.0)
-    dr.enable_grad(s)
+    s = step(0.0)
     w, _, _ = evaluate(make, s, null)
     loss = projection(w, r)
     dr.backward(loss)

@@ -117,10 +117,11 @@ fn recorded_plate(
         given(PlateInput::AxisY, a[1], recipe.axis_is_input),
         given(PlateInput::AxisZ, a[2], recipe.axis_is_input),
     );
-    let angle = input(PlateInput::AxisAngle);
+    let angle = given(PlateInput::AxisAngle, 0.0, recipe.has_axis_angle);
     (!angle.finite()).fail(|| Error::new("axis_angle", "must be a finite number (degrees)"))?;
     let thickness = input(PlateInput::Thickness) * (1000.0 * recipe.thickness_scale);
-    let birefringence = input(PlateInput::Birefringence) * recipe.birefringence_scale;
+    let birefringence = given(PlateInput::Birefringence, 0.0, recipe.has_birefringence)
+        * recipe.birefringence_scale;
     (!birefringence.finite()).fail(|| Error::new("birefringence", "must be finite"))?;
     let real = |n: f64| Cx::new(Var::cst(n), Var::cst(0.0));
     Ok(ExactPlate {
