@@ -15,19 +15,17 @@
 //! interfaces solved once per plate), so the generic sample agrees with it to rounding of a
 //! multiple-reflection sum (1e-9 absolute on power fractions of at most 1).
 
-use birefringent::ffi::bridge::{PlateInput, PlateRecipe, SampleOutput, Transport as T};
+use birefringent::ffi::bridge::{PlateInput, PlateRecipe, Transport as T};
 use birefringent::ffi::{new_materials, record_plate, Materials};
 use birefringent::material::Material;
 use birefringent::params::{Length, Thickness};
-use birefringent::render::choice::choose;
-use birefringent::render::plate::{
-    plate_lobes, sample_exact, ExactPlate, PlateQuery, Spectrum, MAX_BANDS,
-};
+use birefringent::render::plate::{plate_lobes, ExactPlate, PlateQuery};
 use birefringent::render::Transport;
 use birefringent::C64;
 use nalgebra::Vector3;
 
 mod common;
+use common::samples::{assert_program_outputs, assert_scalar_route, direct, exact_bands, Path};
 use common::Rng;
 
 /// One random lane of a plate query, in the plugin's units.
@@ -208,41 +206,21 @@ impl Lane {
         .with_absorbing_exit(self.absorbing_exit)
     }
 
+    /// The path of the lane.
+    fn path(&self) -> Path<'_> {
+        Path {
+            wi: self.wi,
+            u: self.u,
+            wavelengths: &self.wavelengths,
+            transport: self.transport,
+            components: self.components,
+        }
+    }
+
     /// The generic sample run on `f64`, as the program's outputs (without the failure mask).
     fn direct(&self, materials: &Materials) -> Vec<f64> {
-        let w = &self.wavelengths;
-        match w.len() {
-            1 => self.direct_in::<1>(materials),
-            2 => self.direct_in::<2>(materials),
-            3 => self.direct_in::<3>(materials),
-            _ => self.direct_in::<4>(materials),
-        }
+        direct(&ExactPlate::of(&self.query(materials)), &self.path())
     }
-
-    fn direct_in<const C: usize>(&self, materials: &Materials) -> Vec<f64> {
-        let q = ExactPlate::of(&self.query(materials));
-        let w: [f64; C] = std::array::from_fn(|k| self.wavelengths[k]);
-        let s = sample_exact(&q, &w, self.wi, self.u, self.transport, self.components).unwrap();
-        let mut out = vec![
-            f64::from(u8::from(s.valid)),
-            s.slot,
-            s.component,
-            s.pdf,
-            s.eta,
-        ];
-        out.extend(s.wo.iter());
-        for ch in 0..4 {
-            let ch = ch.min(C - 1);
-            out.extend(s.in_x[ch].iter().chain(s.out_x[ch].iter()));
-            out.extend(s.value[ch].transpose().iter());
-        }
-        out
-    }
-}
-
-/// Relative closeness for numbers of order one or smaller.
-fn close(a: f64, b: f64, tol: f64) -> bool {
-    (a - b).abs() <= tol * (1.0 + a.abs().max(b.abs()))
 }
 
 #[test]
@@ -254,12 +232,6 @@ fn the_recorded_program_equals_the_host_sample() {
         let lane = random_lane(&mut rng, &mut materials);
         let program = record_plate(&materials, &lane.recipe()).unwrap();
         let got = program.recorded().run(&lane.inputs());
-        assert_eq!(got.len(), SampleOutput::Count.repr as usize + 1);
-        assert_eq!(
-            got[SampleOutput::Count.repr as usize],
-            0.0,
-            "{lane:?} failed"
-        );
         let want = lane.direct(&materials);
         let shortest = lane
             .wavelengths
@@ -268,17 +240,7 @@ fn the_recorded_program_equals_the_host_sample() {
             .fold(f64::INFINITY, f64::min);
         let d_nm = 1000.0 * lane.thickness_scale * lane.thickness_um;
         let tol = 1e-13 * (1.0 + 10.0 * d_nm / shortest);
-        // A query of fewer than four wavelengths repeats its last in the program's layout.
-        let channels = lane.wavelengths.len();
-        let per = SampleOutput::PerChannel.repr as usize;
-        let first = SampleOutput::Channel0.repr as usize;
-        for (k, (g, w)) in got.iter().zip(&want).enumerate() {
-            let channel = k.checked_sub(first).map(|j| j / per);
-            if channel.is_some_and(|c| c >= channels) {
-                continue;
-            }
-            assert!(close(*g, *w, tol), "output {k}: {g} vs {w}\n{lane:?}");
-        }
+        assert_program_outputs(&got, &want, lane.wavelengths.len(), tol, &lane);
         lanes += 1;
         valid += usize::from(got[0] != 0.0);
     }
@@ -296,47 +258,10 @@ fn the_generic_sample_equals_the_scalar_route() {
     for _ in 0..1500 {
         let lane = random_lane(&mut rng, &mut materials);
         let q = lane.query(&materials);
-        let mut wavelengths_nm = [0.0; MAX_BANDS];
-        wavelengths_nm[..lane.wavelengths.len()].copy_from_slice(&lane.wavelengths);
-        let spectrum = Spectrum::Bands {
-            wavelengths_nm,
-            count: lane.wavelengths.len(),
-            fwhm_nm: 0.0,
-        };
+        let spectrum = exact_bands(&lane.wavelengths);
         let lobes = plate_lobes(&q, &spectrum, lane.wi, lane.transport).unwrap();
-        let enabled = |slot: usize| lane.components & (1 << slot) != 0;
-        let choice = choose(&lobes, enabled, lane.u);
         let got = lane.direct(&materials);
-        assert_eq!(got[0] != 0.0, choice.is_some(), "{lane:?}");
-        let Some(choice) = choice else { continue };
-        let hero = lobes[choice.hero][choice.slot].unwrap();
-        let tol = 1e-9;
-        assert_eq!(got[1], choice.slot as f64);
-        assert!(
-            close(got[3], choice.pdf, tol),
-            "pdf {} vs {}",
-            got[3],
-            choice.pdf
-        );
-        assert!(close(got[4], hero.eta, tol));
-        for k in 0..3 {
-            assert!(close(got[5 + k], hero.wo[k], tol));
-        }
-        let per = SampleOutput::PerChannel.repr as usize;
-        let first = SampleOutput::Channel0.repr as usize;
-        for (c, slots) in lobes.iter().enumerate() {
-            let base = first + per * c;
-            let m = slots[choice.slot].map(|l| l.mueller / choice.pdf);
-            for e in 0..16 {
-                let want = m.map_or(0.0, |m| m[(e / 4, e % 4)]);
-                let g = got[base + 6 + e];
-                assert!(
-                    close(g, want, tol),
-                    "channel {c} entry {e}: {g} vs {want}\n{lane:?}"
-                );
-            }
-        }
-        compared += 1;
+        compared += usize::from(assert_scalar_route(&got, &lobes, &lane.path(), &lane));
     }
     assert!(compared > 700, "{compared} lanes compared");
 }
@@ -348,9 +273,12 @@ fn program_sizes() {
     for (name, m) in [
         ("quartz", materials.add_named("quartz", 0.0, 0.0).unwrap()),
         ("glass", materials.add_constant(1.5, 1.5, 0.0, 0.0).unwrap()),
-        ("aniso const", materials.add_constant(1.5, 1.6, 0.0, 0.0).unwrap()),
+        (
+            "aniso const",
+            materials.add_constant(1.5, 1.6, 0.0, 0.0).unwrap(),
+        ),
     ] {
-        for inputs in [false, true] {
+        for (inputs, exit_ior) in [(false, 1.0), (true, 1.0), (false, 1.5)] {
             let recipe = PlateRecipe {
                 material: m,
                 transport: T::Radiance,
@@ -359,7 +287,7 @@ fn program_sizes() {
                 intensity_only: false,
                 absorbing_exit: false,
                 ext_ior: 1.0,
-                exit_ior: 1.0,
+                exit_ior,
                 thickness_scale: 1.0,
                 has_birefringence: false,
                 birefringence_scale: 1.0,
@@ -371,7 +299,7 @@ fn program_sizes() {
             };
             let p = record_plate(&materials, &recipe).unwrap();
             println!(
-                "{name} inputs {inputs}: {} operations, {} instructions",
+                "{name} inputs {inputs} exit {exit_ior}: {} operations, {} instructions",
                 p.operations(),
                 p.instructions().len()
             );

@@ -25,7 +25,7 @@ mod tangents;
 
 pub use batch::{sample_crystal, sample_crystal_tangents, sample_plate, sample_plate_tangents};
 pub use materials::{new_materials, Materials};
-pub use programs::{record_plate, Program};
+pub use programs::{record_plate, record_stack, Program};
 pub use spectrum::{
     band_spectrum, channels_to_linear_srgb, colour_channel_spectrum, colour_channel_wavelength,
     default_channel, exact_spectrum, srgb_spectrum, PlateSpectrum,
@@ -377,6 +377,88 @@ pub mod bridge {
         axis_is_input: bool,
         indices_are_inputs: bool,
         kappas_are_inputs: bool,
+    }
+
+    /// The path's inputs of a stack's program, by index: `wi`, the sample, four wavelength
+    /// slots (a program of fewer channels reads the first ones), then from `Layer0` one block
+    /// of `StackLayerInput::Stride` inputs per layer, from the exterior down (layer k's input
+    /// i at `Layer0 + k * Stride + i`).
+    #[repr(u32)]
+    #[derive(Debug)]
+    enum StackInput {
+        /// Mitsuba's si.wi (local frame).
+        WiX = 0,
+        WiY = 1,
+        WiZ = 2,
+        /// The lobe-choosing uniform number.
+        Sample = 3,
+        /// The first of `channels` wavelengths (nm).
+        Wavelength0 = 4,
+        /// The first layer's block.
+        Layer0 = 8,
+    }
+
+    /// The inputs of one layer of a stack's program, within its block (`StackInput`): as a
+    /// plate's (`PlateInput`). The texture values are always read; the axis, the indices and
+    /// the extinctions only where the layer's recipe makes them inputs.
+    #[repr(u32)]
+    #[derive(Debug)]
+    enum StackLayerInput {
+        /// The layer's thickness texture value (um, before its thickness_scale).
+        Thickness = 0,
+        /// Its birefringence texture value (before its birefringence_scale; 0 without one).
+        Birefringence = 1,
+        /// Its axis_angle texture value (degrees; 0 without one).
+        AxisAngle = 2,
+        /// Its optic_axis (where `axis_is_input`).
+        AxisX = 3,
+        AxisY = 4,
+        AxisZ = 5,
+        /// Re eta_o, Re eta_e of constant indices (where `indices_are_inputs`).
+        EtaO = 6,
+        EtaE = 7,
+        /// kappa_o, kappa_e (where `kappas_are_inputs`).
+        KappaO = 8,
+        KappaE = 9,
+        /// Inputs per layer.
+        Stride = 10,
+    }
+
+    /// What one layer of a stack's program is recorded for: a nested plate's parameters as in
+    /// `PlateRecipe` (which of them are inputs, the others' values as constants).
+    #[derive(Debug)]
+    struct StackLayerRecipe {
+        material: u32,
+        thickness_scale: f64,
+        /// The layer has a `birefringence` texture (else its input is not read).
+        has_birefringence: bool,
+        birefringence_scale: f64,
+        /// The layer has an `axis_angle` texture (else its input is not read).
+        has_axis_angle: bool,
+        optic_axis: [f64; 3],
+        axis_is_input: bool,
+        indices_are_inputs: bool,
+        kappas_are_inputs: bool,
+    }
+
+    /// What a stack's program is recorded for: the query's settings, the media around the stack
+    /// and its layers from the exterior down (at least one).
+    #[derive(Debug)]
+    struct StackRecipe {
+        transport: Transport,
+        components: u32,
+        channels: u32,
+        intensity_only: bool,
+        absorbing_exit: bool,
+        ext_ior: f64,
+        exit_ior: f64,
+        layers: Vec<StackLayerRecipe>,
+    }
+
+    extern "Rust" {
+        /// Records the sample of a stack over `recipe.channels` exact wavelengths; outputs as
+        /// `record_plate`'s (`SampleOutput`).
+        fn record_stack(materials: &Materials, recipe: &StackRecipe) -> Result<Box<Program>>;
     }
 
     extern "Rust" {

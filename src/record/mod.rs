@@ -7,9 +7,11 @@
 //! Mitsuba's kernels by the JIT variants.
 //!
 //! While recording, operations on constants are folded (in `f64`, as the host would compute
-//! them), equal instructions are recorded once, and `x + 0`, `x · 1`, `x · 0`, a `select` of a
-//! known mask and the like are simplified: a lossless medium's complex arithmetic becomes real
-//! arithmetic by itself.
+//! them), equal instructions are recorded once, and `x + 0`, `x · 1`, `x · 0`, `x − x`,
+//! `x == x`, a `select` of a known mask and the like are simplified (identities of finite
+//! numbers; a lane with a non-finite value fails anyway): a lossless medium's complex
+//! arithmetic becomes real arithmetic by itself, and a medium whose two indices are the same
+//! value is known to be isotropic.
 
 pub mod program;
 
@@ -63,6 +65,16 @@ impl Tape {
     /// Appends `op(a, b, c)` (or finds the equal instruction, or folds it).
     fn push(&mut self, op: Op, mut a: u32, mut b: u32, c: u32, value: f64) -> u32 {
         let n = op.operands();
+        // A value compared with itself (the same recorded value: a finite lane's, or the lane
+        // fails anyway), or subtracted from itself.
+        if n == 2 && a == b {
+            match op {
+                Op::Eq | Op::Le => return self.push(Op::Flag, 0, 0, 0, 1.0),
+                Op::Lt => return self.push(Op::Flag, 0, 0, 0, 0.0),
+                Op::Sub => return self.push(Op::Const, 0, 0, 0, 0.0),
+                _ => {}
+            }
+        }
         if n > 0 {
             if let Some(k) = self.simplify(op, a, b, c) {
                 return k;

@@ -386,9 +386,10 @@ impl<T: Real> Thin<T> for ExactPlate<T> {
 
 /// The lobe a path samples from an exact plate (one wavelength per channel) seen from `wi`,
 /// chosen with the uniform number `u` among the components whose bits `components` sets
-/// (0 reflection, 1 transmission), as Mitsuba's sample ([`choice::sample`]).
-pub fn sample_exact<T: Real, const C: usize>(
-    q: &ExactPlate<T>,
+/// (0 reflection, 1 transmission), as Mitsuba's sample ([`choice::sample`]); the same for any
+/// thin element at exact wavelengths (a stack: [`crate::render::stack::sample_exact_stack`]).
+pub fn sample_exact<T: Real, E: Thin<T, Spectrum = [T]>, const C: usize>(
+    q: &E,
     wavelengths: &[T; C],
     wi: Vector3<T>,
     u: T,

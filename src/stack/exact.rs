@@ -25,17 +25,18 @@ use crate::cmath;
 use crate::error::{Error, Result};
 use crate::optics::frame::PlaneFrame;
 use crate::optics::interface::Interface;
-use crate::optics::medium::Uniaxial;
-use crate::optics::modes::{modes, normal_components, Mode};
+use crate::optics::modes::{isotropic_modes, modes, normal_components, Mode, ModeSet};
 use crate::optics::mueller;
 use crate::plate::slab::{inverse, phase_factors, scale, SlabJones, SlabMueller, Want};
+use crate::real::complex::{self as cx, Cx};
+use crate::real::{Mask, Real};
 use crate::stack::{in_layer, Stack};
 use nalgebra::Matrix2;
 use num_complex::Complex64 as C64;
 
 /// The four blocks of one interface: `[r↓, t↓, r↑, t↑]` (reflection and transmission of waves
 /// arriving from above, then from below), in the modes of the media it joins.
-pub type InterfaceBlocks = [Matrix2<C64>; 4];
+pub type InterfaceBlocks<T = f64> = [Matrix2<Cx<T>>; 4];
 
 /// Index of each block in [`InterfaceBlocks`].
 pub const R_DOWN: usize = 0;
@@ -50,18 +51,18 @@ pub const T_UP: usize = 3;
 pub const INTERFACE_VALUES: usize = 16;
 
 /// Everything the stack's Jones matrices need besides the wavelength: the interface blocks,
-/// the layers' normal components and thicknesses, and the transmission flux factor. The blocks
-/// depend on the wavelength only through the indices.
+/// the layers' normal components and thicknesses, and the transmission flux factor, over the
+/// reals `T` (`f64` on the host). The blocks depend on the wavelength only through the indices.
 #[derive(Clone, Debug, PartialEq)]
-pub struct StackBlocks {
+pub struct StackBlocks<T: Real = f64> {
     /// Interface `j` on top of layer `j` (`N + 1` of them).
-    pub interfaces: Vec<InterfaceBlocks>,
+    pub interfaces: Vec<InterfaceBlocks<T>>,
     /// Layer normal components `[o↓, e↓, o↑, e↑]` (`[s, p, s, p]` if isotropic).
-    pub q: Vec<[C64; 4]>,
+    pub q: Vec<[Cx<T>; 4]>,
     /// Layer thicknesses (nm).
-    pub thickness_nm: Vec<f64>,
+    pub thickness_nm: Vec<T>,
     /// Transmission flux factor `P_exit / P_ext` (0 if the exit wave is evanescent).
-    pub flux: f64,
+    pub flux: T,
 }
 
 /// Every interface of `stack` at `lambda_nm`, solved for incidence parameter `beta` in the plane
@@ -113,27 +114,48 @@ pub fn layer_q_into(
     Ok(())
 }
 
-impl StackBlocks {
-    /// The stack at `lambda_nm` for incidence parameter `beta` in the plane of `frame`: each
-    /// interface solved where it lies (an [`Interface`] is large: moving it costs about as much
-    /// as solving it) and reduced to its blocks.
-    pub fn new(stack: &Stack, lambda_nm: f64, frame: &PlaneFrame, beta: C64) -> Result<Self> {
-        let n = stack.layers.len();
+impl<T: Real> StackBlocks<T> {
+    /// The stack at `lambda_nm` for incidence parameter `beta` in the plane of `frame`
+    /// ([`StackBlocks::solve`] with each layer's modes).
+    pub fn new(stack: &Stack<T>, lambda_nm: T, frame: &PlaneFrame<T>, beta: Cx<T>) -> Result<Self> {
+        let layers = &stack.layers;
+        StackBlocks::solve(
+            stack.ext,
+            stack.exit,
+            layers.iter().map(|l| l.thickness_nm).collect(),
+            beta,
+            |j| {
+                let medium = layers[j].medium(lambda_nm, frame);
+                Ok(modes(&medium.map_err(|e| in_layer(j, e))?, beta))
+            },
+        )
+    }
+
+    /// The stack between the isotropic exterior `ext` and exit medium `exit` whose layer `j`
+    /// (from the exterior down) is `thickness_nm[j]` thick and has the modes `layer(j)` for
+    /// incidence parameter `beta`: each interface solved where it lies (an [`Interface`] is
+    /// large: moving it costs about as much as solving it) and reduced to its blocks.
+    pub fn solve(
+        ext: Cx<T>,
+        exit: Cx<T>,
+        thickness_nm: Vec<T>,
+        beta: Cx<T>,
+        mut layer: impl FnMut(usize) -> Result<ModeSet<T>>,
+    ) -> Result<Self> {
+        let n = thickness_nm.len();
         let mut out = StackBlocks {
             interfaces: Vec::with_capacity(n + 1),
             q: Vec::with_capacity(n),
-            thickness_nm: stack.layers.iter().map(|l| l.thickness_nm).collect(),
-            flux: 0.0,
+            thickness_nm,
+            flux: T::zero(),
         };
-        let top = modes(&Uniaxial::isotropic(stack.ext)?, beta);
+        let top = isotropic_modes(ext, beta);
         let mut iface = Interface::unsolved(top, top);
         for j in 0..=n {
-            let below = match stack.layers.get(j) {
-                Some(l) => modes(
-                    &l.medium(lambda_nm, frame).map_err(|e| in_layer(j, e))?,
-                    beta,
-                ),
-                None => modes(&Uniaxial::isotropic(stack.exit)?, beta),
+            let below = if j < n {
+                layer(j)?
+            } else {
+                isotropic_modes(exit, beta)
             };
             iface.upper = iface.lower;
             iface.lower = below;
@@ -151,6 +173,53 @@ impl StackBlocks {
         Ok(out)
     }
 
+    /// Number of layers.
+    pub fn layers(&self) -> usize {
+        self.q.len()
+    }
+
+    /// The coherent, flux-normalised Jones matrices at `lambda_nm` (module docs), in the s/p
+    /// bases of the exterior (reflection) and of the exit medium (transmission). Fails only at
+    /// an exact internal resonance (a guided mode, which light from outside cannot excite in
+    /// a passive stack; while recording, such lanes fail).
+    pub fn jones(&self, lambda_nm: T, want: Want) -> Result<SlabJones<T>> {
+        let n = self.layers();
+        let last = &self.interfaces[n];
+        let (mut gamma, mut tau) = (last[R_DOWN], last[T_DOWN]);
+        let (one, zero) = (cx::real(T::one()), cx::real(T::zero()));
+        let identity = Matrix2::new(one, zero, zero, one);
+        for j in (0..n).rev() {
+            let (pd, pu) = phase_factors(self.thickness_nm[j], lambda_nm, &self.q[j]);
+            let g = scale(&pu, &gamma, &pd);
+            let iface = &self.interfaces[j];
+            let x =
+                inverse(&(identity - cmath::mul2(&iface[R_UP], &g))).map_err(|_| resonance())?;
+            let y = cmath::mul2(&x, &iface[T_DOWN]);
+            // τ P↓ (I − r↑ Γ')⁻¹ t↓, associated as the slab does (τ (P↓ y)).
+            tau = cmath::mul2(&tau, &scale(&pd, &y, &[one; 2]));
+            // Γ of the layers below is needed further up even when only T is wanted.
+            if j > 0 || want.reflection {
+                gamma = iface[R_DOWN] + cmath::mul2(&iface[T_UP], &cmath::mul2(&g, &y));
+            }
+        }
+        let f = Cx::new(self.flux.sqrt(), T::zero());
+        Ok(SlabJones {
+            r: want.reflection.then_some(gamma),
+            t: want.transmission.then(|| tau.map(|z| z * f)),
+        })
+    }
+
+    /// Mueller matrices (Mitsuba's convention, s/p frames) of reflection and transmission.
+    pub fn mueller(&self, lambda_nm: T, want: Want) -> Result<SlabMueller<T>> {
+        let j = self.jones(lambda_nm, want)?;
+        Ok(SlabMueller {
+            r: j.r.as_ref().map(mueller::from_jones),
+            t: j.t.as_ref().map(mueller::from_jones),
+        })
+    }
+}
+
+impl StackBlocks {
     /// The blocks of solved `interfaces` (as [`interfaces`] gives them) of `stack`.
     pub fn from_interfaces(stack: &Stack, interfaces: &[Interface]) -> Self {
         let layers = stack.layers.len();
@@ -169,49 +238,6 @@ impl StackBlocks {
                 &interfaces[layers].lower.down[0],
             ),
         }
-    }
-
-    /// Number of layers.
-    pub fn layers(&self) -> usize {
-        self.q.len()
-    }
-
-    /// The coherent, flux-normalised Jones matrices at `lambda_nm` (module docs), in the s/p
-    /// bases of the exterior (reflection) and of the exit medium (transmission). Fails only at
-    /// an exact internal resonance (a guided mode, which light from outside cannot excite in
-    /// a passive stack).
-    pub fn jones(&self, lambda_nm: f64, want: Want) -> Result<SlabJones> {
-        let n = self.layers();
-        let last = &self.interfaces[n];
-        let (mut gamma, mut tau) = (last[R_DOWN], last[T_DOWN]);
-        for j in (0..n).rev() {
-            let (pd, pu) = phase_factors(self.thickness_nm[j], lambda_nm, &self.q[j]);
-            let g = scale(&pu, &gamma, &pd);
-            let iface = &self.interfaces[j];
-            let x = inverse(&(Matrix2::identity() - cmath::mul2(&iface[R_UP], &g)))
-                .map_err(|_| resonance())?;
-            let y = cmath::mul2(&x, &iface[T_DOWN]);
-            // τ P↓ (I − r↑ Γ')⁻¹ t↓, associated as the slab does (τ (P↓ y)).
-            tau = cmath::mul2(&tau, &scale(&pd, &y, &[C64::new(1.0, 0.0); 2]));
-            // Γ of the layers below is needed further up even when only T is wanted.
-            if j > 0 || want.reflection {
-                gamma = iface[R_DOWN] + cmath::mul2(&iface[T_UP], &cmath::mul2(&g, &y));
-            }
-        }
-        let f = self.flux.sqrt();
-        Ok(SlabJones {
-            r: want.reflection.then_some(gamma),
-            t: want.transmission.then(|| tau * C64::new(f, 0.0)),
-        })
-    }
-
-    /// Mueller matrices (Mitsuba's convention, s/p frames) of reflection and transmission.
-    pub fn mueller(&self, lambda_nm: f64, want: Want) -> Result<SlabMueller> {
-        let j = self.jones(lambda_nm, want)?;
-        Ok(SlabMueller {
-            r: j.r.as_ref().map(mueller::from_jones),
-            t: j.t.as_ref().map(mueller::from_jones),
-        })
     }
 
     /// The interface blocks and the flux factor as one array ([`INTERFACE_VALUES`] per
@@ -241,18 +267,19 @@ impl StackBlocks {
 }
 
 /// `[r↓, t↓, r↑, t↑]` of a solved interface.
-fn blocks_of(i: &Interface) -> InterfaceBlocks {
+fn blocks_of<T: Real>(i: &Interface<T>) -> InterfaceBlocks<T> {
     [i.r_above(), i.t_above(), i.r_below(), i.t_below()]
 }
 
-/// Flux factor `P_out / P_in` of the transmitted wave (eq. S19; 0 if it is evanescent).
-fn flux_ratio(incident: &Mode, transmitted: &Mode) -> f64 {
+/// Flux factor `P_out / P_in` of the transmitted wave (eq. S19; 0 if it is evanescent). The
+/// division is by 1 in the lanes that discard it (their derivatives stay finite).
+fn flux_ratio<T: Real>(incident: &Mode<T>, transmitted: &Mode<T>) -> T {
     let p_in = incident.flux.abs();
-    if p_in > 0.0 && !transmitted.is_evanescent() {
-        transmitted.flux.abs() / p_in
-    } else {
-        0.0
-    }
+    let carries = p_in.gt(T::zero()) & !transmitted.is_evanescent();
+    carries.when(
+        || transmitted.flux.abs() / carries.when(|| p_in, T::one),
+        T::zero,
+    )
 }
 
 /// The error of a diverging multiple-reflection sum.

@@ -23,20 +23,24 @@ use crate::material::{check_clear_index, Material};
 use crate::optics::frame::PlaneFrame;
 use crate::optics::medium::Uniaxial;
 use crate::params::Thickness;
+use crate::real::complex::Cx;
+use crate::real::Real;
 use nalgebra::Vector3;
 use num_complex::Complex64 as C64;
 
-/// One layer of a stack: a plane-parallel uniaxial (or isotropic) plate.
+/// One layer of a stack: a plane-parallel uniaxial (or isotropic) plate, over the reals `T`
+/// (`f64` on the host, recorded numbers in a program whose layers' values are inputs).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Layer {
+pub struct Layer<T: Real = f64> {
     /// Its principal indices (possibly dispersive).
-    pub material: Material,
+    pub material: Material<T>,
     /// Added to `Re η_e` (photoelastic stress), 0 for none.
-    pub birefringence: f64,
-    /// Unit optic axis in the local frame (`z` the normal towards the exterior).
-    pub axis: Vector3<f64>,
+    pub birefringence: T,
+    /// Optic axis in the local frame (`z` the normal towards the exterior): a unit vector as
+    /// [`Layer::new`] makes it, any non-zero length for [`Layer::local_medium`].
+    pub axis: Vector3<T>,
     /// Thickness (nm).
-    pub thickness_nm: f64,
+    pub thickness_nm: T,
 }
 
 impl Layer {
@@ -56,12 +60,25 @@ impl Layer {
             thickness_nm: thickness.nm(),
         })
     }
+}
+
+impl<T: Real> Layer<T> {
+    /// The layer's medium at `lambda_nm`, its unit axis in the local frame. The indices are
+    /// checked ([`Material::indices`]); the axis is not again (validated by [`Layer::new`], or a
+    /// program's input).
+    pub fn local_medium(&self, lambda_nm: T) -> Result<Uniaxial<T>> {
+        let (eta_o, eta_e) = self.material.indices(lambda_nm, self.birefringence)?;
+        // As the plate builds its layer (`Plate::at`, `Slab::optics`), bit for bit.
+        Ok(Uniaxial {
+            eta_o,
+            eta_e,
+            axis: self.axis / self.axis.dot(&self.axis).sqrt(),
+        })
+    }
 
     /// The layer's medium at `lambda_nm`, its axis in the working frame of `frame`.
-    pub fn medium(&self, lambda_nm: f64, frame: &PlaneFrame) -> Result<Uniaxial> {
-        let (eo, ee) = self.material.indices(lambda_nm, self.birefringence)?;
-        // As the plate builds its layer (`Plate::at`, `Slab::optics`), bit for bit.
-        let local = Uniaxial::new(eo, ee, self.axis)?;
+    pub fn medium(&self, lambda_nm: T, frame: &PlaneFrame<T>) -> Result<Uniaxial<T>> {
+        let local = self.local_medium(lambda_nm)?;
         Ok(local.with_axis(frame.to_working(local.axis)))
     }
 
@@ -71,7 +88,7 @@ impl Layer {
     }
 
     /// The same layer mirrored through its plane (`z → −z`): the layer seen from below.
-    fn mirrored(&self) -> Self {
+    pub fn mirrored(&self) -> Self {
         Layer {
             axis: Vector3::new(self.axis.x, self.axis.y, -self.axis.z),
             ..*self
@@ -82,13 +99,13 @@ impl Layer {
 /// A stack of layers between an isotropic exterior (above, where light arrives from) and an
 /// isotropic exit medium (below). `layers[0]` touches the exterior.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Stack {
+pub struct Stack<T: Real = f64> {
     /// The layers, from the exterior down.
-    pub layers: Vec<Layer>,
+    pub layers: Vec<Layer<T>>,
     /// Exterior index (real).
-    pub ext: C64,
+    pub ext: Cx<T>,
     /// Exit index (real).
-    pub exit: C64,
+    pub exit: Cx<T>,
 }
 
 impl Stack {
@@ -105,14 +122,16 @@ impl Stack {
         })
     }
 
-    /// True if any layer's indices vary with wavelength.
-    pub fn is_dispersive(&self) -> bool {
-        self.layers.iter().any(Layer::is_dispersive)
-    }
-
     /// Total thickness (nm).
     pub fn thickness_nm(&self) -> f64 {
         self.layers.iter().map(|l| l.thickness_nm).sum()
+    }
+}
+
+impl<T: Real> Stack<T> {
+    /// True if any layer's indices vary with wavelength.
+    pub fn is_dispersive(&self) -> bool {
+        self.layers.iter().any(Layer::is_dispersive)
     }
 
     /// The same stack seen from below: exterior and exit swapped, the layers in reverse order,
@@ -126,14 +145,14 @@ impl Stack {
     }
 
     /// The media from the exterior down at `lambda_nm` (exterior, layers, exit), axes in the
-    /// working frame of `frame`.
-    pub fn media(&self, lambda_nm: f64, frame: &PlaneFrame) -> Result<Vec<Uniaxial>> {
+    /// working frame of `frame`; a layer's error under its name ([`in_layer`]).
+    pub fn media(&self, lambda_nm: T, frame: &PlaneFrame<T>) -> Result<Vec<Uniaxial<T>>> {
         let mut media = Vec::with_capacity(self.layers.len() + 2);
-        media.push(Uniaxial::isotropic(self.ext)?);
-        for layer in &self.layers {
-            media.push(layer.medium(lambda_nm, frame)?);
+        media.push(Uniaxial::isotropic_unchecked(self.ext));
+        for (j, layer) in self.layers.iter().enumerate() {
+            media.push(layer.medium(lambda_nm, frame).map_err(|e| in_layer(j, e))?);
         }
-        media.push(Uniaxial::isotropic(self.exit)?);
+        media.push(Uniaxial::isotropic_unchecked(self.exit));
         Ok(media)
     }
 }

@@ -4,6 +4,7 @@
 
 pub mod band;
 pub mod berreman;
+pub mod samples;
 
 use nalgebra::Vector3;
 

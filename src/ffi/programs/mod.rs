@@ -4,9 +4,12 @@
 //! Dr.Jit's derivatives). The inputs and outputs of each program are the bridge's enums
 //! (`PlateInput`, `SampleOutput`): the one contract with the shim. One module per plugin.
 
+mod layer;
 mod plate;
+mod stack;
 
 pub use plate::record_plate;
+pub use stack::record_stack;
 
 use super::bridge::{Instr, Op as BridgeOp, SampleOutput, Transport};
 use crate::error::{Error, Result};

@@ -1,16 +1,15 @@
 //! The program of a `thinbirefringent` plate's sample.
 
+use super::layer::{recorded_layer, Param, Settings};
 use super::{core_transport, outputs, Program};
 use crate::error::{Error, Result};
 use crate::ffi::bridge::{PlateInput, PlateRecipe};
 use crate::ffi::materials::Materials;
-use crate::material::{Index, Material};
-use crate::optics::frame::rotated_about_normal;
-use crate::params::{Length, Thickness};
+use crate::material::Material;
 use crate::plate::slab::{Output as Intensity, Want};
 use crate::plate::Plate;
 use crate::real::complex::Cx;
-use crate::real::{Mask, Real};
+use crate::real::Real;
 use crate::record::{self, Var};
 use crate::render::plate::{sample_exact, ExactPlate, MAX_BANDS};
 use nalgebra::Vector3;
@@ -79,59 +78,45 @@ pub fn record_plate(materials: &Materials, recipe: &PlateRecipe) -> Result<Box<P
 }
 
 /// The plate of `recipe` with its per-lane values and the parameters that carry derivatives
-/// as inputs, the others as constants.
+/// as inputs, the others as constants ([`recorded_layer`]).
 fn recorded_plate(
     material: &Material,
     recipe: &PlateRecipe,
     input: &impl Fn(PlateInput) -> Var,
 ) -> Result<ExactPlate<Var>> {
-    let given = |k: PlateInput, value: f64, is_input: bool| {
-        if is_input {
-            input(k)
-        } else {
-            Var::cst(value)
-        }
+    let settings = Settings {
+        thickness_scale: recipe.thickness_scale,
+        has_birefringence: recipe.has_birefringence,
+        birefringence_scale: recipe.birefringence_scale,
+        has_axis_angle: recipe.has_axis_angle,
+        optic_axis: recipe.optic_axis,
+        axis_is_input: recipe.axis_is_input,
+        indices_are_inputs: recipe.indices_are_inputs,
+        kappas_are_inputs: recipe.kappas_are_inputs,
     };
-    let lift = |index: &Index, (re, im): (PlateInput, PlateInput)| match *index {
-        Index::Constant(n) => Index::Constant(Cx::new(
-            given(re, n.re, recipe.indices_are_inputs),
-            given(im, n.im, recipe.kappas_are_inputs),
-        )),
-        Index::Crystal {
-            crystal,
-            extraordinary,
-            kappa,
-        } => Index::Crystal {
-            crystal,
-            extraordinary,
-            kappa: given(im, kappa, recipe.kappas_are_inputs),
-        },
-    };
-    let material = Material {
-        eta_o: lift(&material.eta_o, (PlateInput::EtaO, PlateInput::KappaO)),
-        eta_e: lift(&material.eta_e, (PlateInput::EtaE, PlateInput::KappaE)),
-    };
-    let a = recipe.optic_axis;
-    let axis = Vector3::new(
-        given(PlateInput::AxisX, a[0], recipe.axis_is_input),
-        given(PlateInput::AxisY, a[1], recipe.axis_is_input),
-        given(PlateInput::AxisZ, a[2], recipe.axis_is_input),
-    );
-    let angle = given(PlateInput::AxisAngle, 0.0, recipe.has_axis_angle);
-    (!angle.finite()).fail(|| Error::new("axis_angle", "must be a finite number (degrees)"))?;
-    let thickness = input(PlateInput::Thickness) * (1000.0 * recipe.thickness_scale);
-    let birefringence = given(PlateInput::Birefringence, 0.0, recipe.has_birefringence)
-        * recipe.birefringence_scale;
-    (!birefringence.finite()).fail(|| Error::new("birefringence", "must be finite"))?;
+    let layer = recorded_layer(material, &settings, &|p| {
+        input(match p {
+            Param::Thickness => PlateInput::Thickness,
+            Param::Birefringence => PlateInput::Birefringence,
+            Param::AxisAngle => PlateInput::AxisAngle,
+            Param::AxisX => PlateInput::AxisX,
+            Param::AxisY => PlateInput::AxisY,
+            Param::AxisZ => PlateInput::AxisZ,
+            Param::EtaO => PlateInput::EtaO,
+            Param::EtaE => PlateInput::EtaE,
+            Param::KappaO => PlateInput::KappaO,
+            Param::KappaE => PlateInput::KappaE,
+        })
+    })?;
     let real = |n: f64| Cx::new(Var::cst(n), Var::cst(0.0));
     Ok(ExactPlate {
         plate: Plate {
-            material,
-            birefringence,
+            material: layer.material,
+            birefringence: layer.birefringence,
             ext: real(recipe.ext_ior),
             exit: real(recipe.exit_ior),
-            axis: rotated_about_normal(axis, angle),
-            thickness_nm: Thickness::checked("thickness", thickness, Length::Micrometres)?,
+            axis: layer.axis,
+            thickness_nm: layer.thickness_nm,
         },
         want: Want {
             reflection: recipe.components & 1 != 0,
