@@ -82,6 +82,7 @@ evaluated with ``eval_1`` at the hit point.
                    'axis_angle': 45.0}
 */
 #include "plugins.h"
+#include "recorded.h"
 #include "last_valid.h"
 #include "layer.h"
 #include "signed_rgb.h"
@@ -133,8 +134,10 @@ public:
         cb->put("ext_ior", m_ext_ior, ParamFlags::NonDifferentiable);
         cb->put("exit_ior", m_exit_ior, ParamFlags::NonDifferentiable);
         cb->put("filter_bandwidth", m_filter_bandwidth, ParamFlags::NonDifferentiable);
+        // The layers' own parameters (differentiable as a plate's: the JIT spectral variants
+        // replay the stack's program with Dr.Jit's derivatives).
         for (size_t k = 0; k < m_layers.size(); ++k)
-            cb->put(m_names[k], m_layers[k], ParamFlags::NonDifferentiable);
+            cb->put(m_names[k], m_layers[k], shim::texture_flags<Float>());
     }
 
     /// Applies changed parameters (the stack's or its layers'); a rejected update leaves the last
@@ -172,6 +175,7 @@ private:
         shim::thin_flags(isotropic, m_null, m_absorbing_exit, m_exit_ior != m_ext_ior, m_types,
                          m_components, m_flags);
         check_at_load();
+        m_programs.clear();
     }
 
 public:
@@ -183,6 +187,9 @@ public:
                               (ctx.is_enabled(m_types[1], 1) ? 2u : 0u);
         if (!components || shim::none_active(active))
             return { dr::zeros<BSDFSample3f>(), dr::zeros<Spectrum>() };
+        if constexpr (Recordable)
+            if (m_filter_bandwidth == 0.0)
+                return replayed(si, ctx.mode, components, sample1, active, false);
         return query(si, ctx.mode, components, sample1, active, false).sample();
     }
 
@@ -201,6 +208,9 @@ public:
         MI_MASKED_FUNCTION(ProfilerPhase::BSDFEvaluate, active);
         if (!m_null || shim::none_active(active))
             return dr::zeros<Spectrum>();
+        if constexpr (Recordable)
+            if (m_filter_bandwidth == 0.0)
+                return replayed(si, TransportMode::Radiance, 2u, Float(0.5f), active, true).second;
         return query(si, TransportMode::Radiance, 2u, Float(0.5f), active, true).spectrum();
     }
 
@@ -315,7 +325,7 @@ private:
     /** The core's lobe for every lane of `si` (see thinbirefringent.cpp's `query`). */
     Answers query(const SurfaceInteraction3f &si, TransportMode mode, uint32_t components,
                   const Float &sample1, const Mask &active, bool straight) const {
-        shim::require_evaluated_mode<Float>(ClassName, "no query of this plugin yet");
+        shim::require_evaluated_mode<Float>(ClassName, "filter_bandwidth = 0 in a spectral variant");
         shim::HostInputs<Float, Inputs> in;
         const shim::PathColumns path = shim::add_path_inputs<Float, Spectrum>(in, si, sample1, active);
         const size_t n_layers = m_sources.size();
@@ -384,6 +394,88 @@ private:
         return answers;
     }
 
+    /// The variants where a query can be the exact stack at each sampled wavelength, recorded
+    /// by the core as a program replayed inside Mitsuba's kernels (the JIT spectral variants,
+    /// with filter_bandwidth 0); the other JIT queries call the core on the host.
+    static constexpr bool Recordable = dr::is_jit_v<Float> && is_spectral_v<Spectrum>;
+
+    /// The key of a program: the transport mode, the enabled components and, per layer, which
+    /// of its parameters carry derivatives (bits: axis, indices, extinctions).
+    using ProgramKey = std::tuple<bool, uint32_t, std::vector<uint8_t>>;
+
+    /// The sample of the program of this setting, replayed on the lanes of `si` (recorded.h).
+    std::pair<BSDFSample3f, Spectrum> replayed(const SurfaceInteraction3f &si,
+                                               TransportMode mode, uint32_t components,
+                                               const Float &sample1, const Mask &active,
+                                               bool straight) const {
+        using In = bfr::StackInput;
+        using LayerIn = bfr::StackLayerInput;
+        using Answer = shim::Replayed<Float, Spectrum>;
+        constexpr size_t Channels = Answer::Channels;
+        const size_t n_layers = m_sources.size();
+        bool radiance = mode == TransportMode::Radiance;
+        std::vector<Layer> layers;
+        std::vector<uint8_t> inputs;
+        for (size_t k = 0; k < n_layers; ++k) {
+            Layer l = m_sources[k]->layer();
+            const auto &d = *l.diff;
+            inputs.push_back((dr::grad_enabled(d.optic_axis()) ? 1 : 0) |
+                             (!l.material->named && dr::grad_enabled(d.eta_o(), d.eta_e()) ? 2 : 0) |
+                             (dr::grad_enabled(d.kappa_o(), d.kappa_e()) ? 4 : 0));
+            layers.push_back(l);
+        }
+        ProgramKey key{ radiance, components, inputs };
+        const bfr::Program &program = m_programs.get(key, [&] {
+            bfr::StackRecipe recipe{ radiance ? bfr::Transport::Radiance
+                                              : bfr::Transport::Importance,
+                                     components,
+                                     (uint32_t) Channels,
+                                     !is_polarized_v<Spectrum>,
+                                     m_absorbing_exit,
+                                     m_ext_ior,
+                                     m_exit_ior,
+                                     {} };
+            for (size_t k = 0; k < n_layers; ++k) {
+                const Layer &l = layers[k];
+                const auto &a = l.optic_axis;
+                recipe.layers.push_back(bfr::StackLayerRecipe{
+                    m_material_index[k], l.thickness_scale, l.birefringence != nullptr,
+                    l.birefringence_scale, l.axis_angle != nullptr,
+                    { (double) a.x(), (double) a.y(), (double) a.z() }, (inputs[k] & 1) != 0,
+                    (inputs[k] & 2) != 0, (inputs[k] & 4) != 0 });
+            }
+            return shim::core_call(ClassName, [&] { return bfr::record_stack(*m_material, recipe); });
+        });
+        const size_t stride = (size_t) LayerIn::Stride, first = (size_t) In::Layer0;
+        std::vector<Float> x(first + stride * n_layers, Float(0.f));
+        x[(size_t) In::WiX] = si.wi.x();
+        x[(size_t) In::WiY] = si.wi.y();
+        x[(size_t) In::WiZ] = si.wi.z();
+        x[(size_t) In::Sample] = sample1;
+        if constexpr (is_spectral_v<Spectrum>)
+            for (size_t c = 0; c < Channels; ++c)
+                x[(size_t) In::Wavelength0 + c] = si.wavelengths[c];
+        for (size_t k = 0; k < n_layers; ++k) {
+            const Layer &l = layers[k];
+            auto set = [&](LayerIn i, const Float &v) { x[first + stride * k + (size_t) i] = v; };
+            set(LayerIn::Thickness, l.thickness->eval_1(si, active));
+            if (l.birefringence)
+                set(LayerIn::Birefringence, l.birefringence->eval_1(si, active));
+            if (l.axis_angle)
+                set(LayerIn::AxisAngle, l.axis_angle->eval_1(si, active));
+            Vector3f axis = l.diff->optic_axis();
+            set(LayerIn::AxisX, axis.x());
+            set(LayerIn::AxisY, axis.y());
+            set(LayerIn::AxisZ, axis.z());
+            set(LayerIn::EtaO, l.diff->eta_o());
+            set(LayerIn::EtaE, l.diff->eta_e());
+            set(LayerIn::KappaO, l.diff->kappa_o());
+            set(LayerIn::KappaE, l.diff->kappa_e());
+        }
+        shim::Replay<Float> r(program, x);
+        return Answer::sample(r, si.wi, radiance, straight, m_types, 2, active);
+    }
+
     std::vector<ref<Base>> m_layers;
     std::vector<Source *> m_sources;  ///< the layers as LayerSource (the same objects)
     std::vector<std::string> m_names;  ///< layer_0, layer_1, ...
@@ -398,6 +490,8 @@ private:
     mutable std::atomic<bool> m_warned { false };
     shim::SignedRgbGuard m_signed_rgb { is_rgb_v<Spectrum> && !dr::is_jit_v<Float> };
     std::unique_ptr<shim::Snapshot<Float, Spectrum>> m_valid;
+    /// The programs of the JIT spectral variants (Recordable), by ProgramKey.
+    mutable shim::Programs<ProgramKey> m_programs;
 };
 
 NAMESPACE_BEGIN(shim)

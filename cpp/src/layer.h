@@ -4,6 +4,7 @@
 #pragma once
 
 #include "plugins.h"
+#include "differentiable.h"
 
 #include <string>
 #include <vector>
@@ -19,6 +20,8 @@ template <typename Float, typename Spectrum> struct PlateLayer {
 
     const MaterialParams *material = nullptr;
     ScalarVector3f optic_axis;
+    /// The plate's differentiable parameters (their Dr.Jit handles in the JIT variants).
+    const Differentiable<Float> *diff = nullptr;
     const TextureT *thickness = nullptr;  ///< micrometres, times thickness_scale
     double thickness_scale = 1.0;
     const TextureT *birefringence = nullptr;  ///< none if null

@@ -307,6 +307,7 @@ public:
         shim::PlateLayer<Float, Spectrum> l;
         l.material = &m_diff.material;
         l.optic_axis = m_diff.axis;
+        l.diff = &m_diff;
         l.thickness = m_thickness.get();
         l.thickness_scale = m_thickness_scale;
         l.birefringence = m_birefringence.get();

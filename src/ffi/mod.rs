@@ -399,16 +399,17 @@ pub mod bridge {
     }
 
     /// The inputs of one layer of a stack's program, within its block (`StackInput`): as a
-    /// plate's (`PlateInput`). The texture values are always read; the axis, the indices and
-    /// the extinctions only where the layer's recipe makes them inputs.
+    /// plate's (`PlateInput`). The thickness is always read, the other textures' values where
+    /// the layer has them; the axis, the indices and the extinctions where the layer's recipe
+    /// makes them inputs.
     #[repr(u32)]
     #[derive(Debug)]
     enum StackLayerInput {
         /// The layer's thickness texture value (um, before its thickness_scale).
         Thickness = 0,
-        /// Its birefringence texture value (before its birefringence_scale; 0 without one).
+        /// Its birefringence texture value (before its birefringence_scale), where it has one.
         Birefringence = 1,
-        /// Its axis_angle texture value (degrees; 0 without one).
+        /// Its axis_angle texture value (degrees), where it has one.
         AxisAngle = 2,
         /// Its optic_axis (where `axis_is_input`).
         AxisX = 3,

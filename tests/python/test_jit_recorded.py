@@ -55,6 +55,30 @@ def plates():
     ]
 
 
+def stacks():
+    tape = {"type": "thinbirefringent", "eta_o": 1.47, "eta_e": 1.478}
+    return [
+        ("quartz-and-tapes", {"type": "birefringentstack", "ext_ior": 1.0, "exit_ior": 1.2,
+                              "quartz": {"type": "thinbirefringent", "material": "quartz",
+                                         "thickness": 12.0, "axis_angle": checker(0.0, 60.0)},
+                              "tape_1": dict(tape, thickness=checker(20.0, 40.0),
+                                             birefringence=checker(0.0, 0.002)),
+                              "tape_2": dict(tape, thickness=35.0,
+                                             axis_angle=checker(30.0, 100.0))}),
+        ("zero-order-qwp", {"type": "birefringentstack",
+                            "a": {"type": "thinbirefringent", "material": "quartz",
+                                  "thickness": 1000.0, "optic_axis": [1, 0, 0]},
+                            "b": {"type": "thinbirefringent", "material": "quartz",
+                                  "thickness": 983.6, "optic_axis": [0, 1, 0]}}),
+        ("absorbing-dichroic", {"type": "birefringentstack", "exit_ior": 1.5,
+                                "film": {"type": "thinbirefringent", "eta_o": 2.0, "eta_e": 2.0,
+                                         "kappa_o": 0.3, "kappa_e": 0.3, "thickness": 0.02},
+                                "polariser": {"type": "thinbirefringent", "eta_o": 1.5,
+                                              "eta_e": 1.55, "kappa_e": 0.05,
+                                              "thickness": 8.0, "optic_axis": [1, 1, 0]}}),
+    ]
+
+
 def lanes(seed: int, n: int):
     rng = np.random.default_rng(seed)
     wi = random_directions(n, rng, min_abs_cos=2e-3)  # to 89.9 degrees
@@ -107,19 +131,19 @@ def weight_error(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.abs(a - b).max() / scale) if scale > 1e-30 else 0.0
 
 
-@pytest.mark.parametrize("variant", ["llvm_ad_spectral_polarized", "llvm_ad_spectral"])
-def test_recorded_plate_equals_the_scalar_core(variant):
-    """6000 lanes (polarized; 1800 unpolarized) over six plates, both modes and sides."""
-    per_plate = 500 if "polarized" in variant else 150
+def compare(variant: str, cases, per_case: int):
+    """Every case's lanes in both modes against the scalar variant; returns (lanes compared,
+    lanes that chose another lobe, worst weight error)."""
     scalar = variant.replace("llvm_ad", "scalar")
     compared, flipped, worst = 0, 0, 0.0
-    mi.set_variant(variant)
-    for k, (name, desc) in enumerate(plates()):
-        wi, uv, waves, u = lanes(10 + k, per_plate)
+    for k in range(len(cases())):
+        wi, uv, waves, u = lanes(10 + k, per_case)
         for mode in ("radiance", "importance"):
             mi.set_variant(variant)
-            got = jit_lanes(variant, plates()[k][1], mode, wi, uv, waves, u, False)
-            want = scalar_lanes(scalar, plates()[k][1], mode, wi, uv, waves, u, False)
+            name = cases()[k][0]
+            got = jit_lanes(variant, cases()[k][1], mode, wi, uv, waves, u, False)
+            mi.set_variant(scalar)
+            want = scalar_lanes(scalar, cases()[k][1], mode, wi, uv, waves, u, False)
             for i, (wo, pdf, eta, comp, w) in enumerate(want):
                 if got[3][i] != comp:
                     flipped += 1
@@ -135,9 +159,31 @@ def test_recorded_plate_equals_the_scalar_core(variant):
                 worst = max(worst, e)
                 assert e <= TOL, (name, mode, i, wi[i], waves[i], e)
                 compared += 1
+    return compared, flipped, worst
+
+
+@pytest.mark.parametrize("variant", ["llvm_ad_spectral_polarized", "llvm_ad_spectral"])
+def test_recorded_plate_equals_the_scalar_core(variant):
+    """6000 lanes (polarized; 1800 unpolarized) over six plates, both modes and sides."""
+    mi.set_variant(variant)
+    per_plate = 500 if "polarized" in variant else 150
+    compared, flipped, worst = compare(variant, plates, per_plate)
     lanes_total = 2 * per_plate * len(plates())
     print(f"{variant}: {compared} of {lanes_total} lanes compared, {flipped} chose another "
           f"lobe at a boundary, worst weight error {worst:.2e} of the largest entry")
+    assert flipped <= 0.002 * lanes_total
+    assert compared >= 0.99 * lanes_total
+
+
+def test_recorded_stack_equals_the_scalar_core():
+    """1800 lanes over three stacks (textured layers, a zero-order quarter-wave plate of two
+    crossed quartz plates, an absorbing film on a dichroic layer), both modes and sides."""
+    variant = "llvm_ad_spectral_polarized"
+    mi.set_variant(variant)
+    compared, flipped, worst = compare(variant, stacks, 300)
+    lanes_total = 2 * 300 * len(stacks())
+    print(f"stacks: {compared} of {lanes_total} lanes compared, {flipped} chose another lobe, "
+          f"worst weight error {worst:.2e}")
     assert flipped <= 0.002 * lanes_total
     assert compared >= 0.99 * lanes_total
 
