@@ -27,7 +27,6 @@ from pathlib import Path
 
 import drjit as dr
 import mitsuba as mi
-import numpy as np
 
 import mitsuba_birefringent
 from mitsuba_birefringent.names import listed
@@ -164,7 +163,7 @@ def write_image(film, path: Path) -> None:
     if ext in FLOAT_EXTENSIONS:
         colour.write(str(path))
     else:
-        mi.util.convert_to_bitmap(np.array(colour)).write(str(path))
+        mi.util.convert_to_bitmap(colour).write(str(path))
 
 
 @contextlib.contextmanager
