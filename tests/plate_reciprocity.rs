@@ -128,7 +128,7 @@ fn band_radiance_lobes_are_the_reversed_forward_lobes() {
 }
 
 /// sRGB channels, plates in air up to 72 degrees: each side is integrated to the perceptual
-/// budget (`crate::spectral::channels`) from its own nodes, so the two agree to that budget's
+/// budget (`crate::spectral::budget`) from its own nodes, so the two agree to that budget's
 /// Mueller-entry scale, not to rounding (measured worst 5.8e-4).
 #[test]
 fn srgb_radiance_lobes_are_the_reversed_forward_lobes() {

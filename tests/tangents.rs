@@ -768,3 +768,89 @@ fn requests_without_derivatives_are_refused_with_the_reason() {
     let (mut s, _) = o.views(&[]);
     assert_eq!(sample_crystal(&m, 7, &lanes, &mut s), Status::Ok);
 }
+
+/// An optic axis of any length (the plugins take one; the core uses its direction): the
+/// derivatives with respect to the components of `s · a` are those with respect to the unit
+/// axis `a` divided by `s` (`d/dv f(v/|v|) = (I − â âᵀ) ∇f / |v|`), and the derivative along
+/// the axis itself is zero (its length changes nothing). A plate (transmission, polarised,
+/// three wavelengths, tilted incidence) and a crystal surface (its e-refraction, whose
+/// direction moves with the axis), for `s` = 0.4 and 2.5: each column within 1e-6 of the
+/// largest (the central differences' own error is ~1e-9 here, measured).
+#[test]
+fn a_non_unit_axis_has_the_unit_axis_derivatives_over_its_length() {
+    let plate = PlateSetup {
+        ext: 1.0,
+        exit: 1.2,
+        waves: vec![450.0, 550.0, 650.0],
+        transport: Transport::Radiance,
+        intensity_only: false,
+    };
+    let crystal = CrystalSetup {
+        ext: 1.0,
+        waves: vec![450.0, 550.0, 650.0],
+        transport: Transport::Importance,
+    };
+    let unit = Vector3::new(0.6, 0.3, 0.742).normalize();
+    let wi = Vector3::new(0.4, -0.2, 0.8).normalize();
+    let mut p = point(constant(1.54, 1.59), wi);
+    p.thickness_nm = 12_000.0;
+    let derivatives = |axis: Vector3<f64>, crystal_lane: bool| -> Columns {
+        let mut q = p;
+        q.axis = axis;
+        if !crystal_lane {
+            return plate_derivatives(&plate, q, 1, &[Input::OpticAxis]);
+        }
+        let lobes = crystal.at(&q).unwrap();
+        let at = |r: &Point| crystal.at(r);
+        Lane {
+            point: q,
+            transport: crystal.transport,
+            bulk: true,
+            shortest_nm: 450.0,
+            lobes: &lobes,
+            // The e-refraction's slot, chosen with probability 1.
+            choice: Choice {
+                slot: 2,
+                pdf: 1.0,
+                hero: 0,
+            },
+            intensity_only: false,
+            at: &at,
+        }
+        .derivatives(&[Input::OpticAxis])
+    };
+    for crystal_lane in [false, true] {
+        let reference = derivatives(unit, crystal_lane);
+        let size = (0..3)
+            .flat_map(|j| reference.value[j].iter().flatten().chain(&reference.wo[j]))
+            .fold(0.0f64, |m, x| m.max(x.abs()));
+        assert!(size > 1e-3, "the axis changes nothing: {size}");
+        // Along the axis: nothing.
+        let radial = (0..16)
+            .map(|e| {
+                (0..3)
+                    .map(|j| reference.value[j][0][e] * unit[j])
+                    .sum::<f64>()
+            })
+            .fold(0.0f64, |m, x| m.max(x.abs()));
+        assert!(radial < 1e-9 * size, "along the axis: {radial:e}");
+        for s in [0.4, 2.5] {
+            let scaled = derivatives(unit * s, crystal_lane);
+            let mut worst = 0.0f64;
+            for j in 0..3 {
+                for (a, b) in scaled.value[j]
+                    .iter()
+                    .flatten()
+                    .zip(reference.value[j].iter().flatten())
+                {
+                    worst = worst.max((a * s - b).abs());
+                }
+                for (a, b) in scaled.wo[j].iter().zip(&reference.wo[j]) {
+                    worst = worst.max((a * s - b).abs());
+                }
+            }
+            println!("crystal {crystal_lane}, |axis| {s}: worst {worst:.1e} of {size:.2}");
+            assert!(worst < 1e-6 * size, "|axis| {s}: {worst:e} of {size}");
+        }
+    }
+}

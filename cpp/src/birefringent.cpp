@@ -49,7 +49,8 @@ Bulk birefringent crystal (:monosp:`birefringent`)
    - ``"local"``: ``optic_axis`` is in the shading frame (x = dp/du, z = normal; fine for a flat
      face, e.g. a ``rectangle``); ``"world"``: in world space, converted to each hit's shading
      frame, so that every face of a crystal object (a ``cube``, a mesh) sees the same crystal.
-     (Default: ``"local"``)
+     (Default: ``"local"``, said in a warning at load when a birefringent material's
+     ``optic_axis`` is given without it)
 
  * - ext_ior
    - |float| or |string|
@@ -75,7 +76,8 @@ refracted out is component 1 or 2 by its mode inside. Lobes are sampled in propo
 unpolarised weight. Which of o and e a ray inside the crystal is lives in its Stokes vector, so
 double refraction needs a polarized variant; an isotropic material (``eta_o == eta_e``,
 ``kappa_o == kappa_e``) works in every variant. The physics is the core's
-``bfr_crystal_lobes`` (docs/physics.md, sections 2 and 5).
+``sample_crystal``, through ``render::crystal::crystal_slots`` (docs/physics.md, sections 2
+and 5).
 
 .. tabs::
     .. code-tab:: xml
@@ -147,7 +149,13 @@ public:
         if (!props.has_property("optic_axis") && !m_material->is_isotropic(0))
             defaults.add("optic_axis = [1, 0, 0] in the shading frame of each hit (give it, and "
                          "optic_axis_space \"world\" for a crystal object such as a cube)");
-        defaults.log(ClassName);
+        else if (!props.has_property("optic_axis_space") && !m_material->is_isotropic(0))
+            defaults.add("optic_axis_space = \"local\": optic_axis is in the shading frame of "
+                         "each hit, which turns with the surface (every face of a cube, every "
+                         "point of a sphere or a mesh sees another crystal); give "
+                         "optic_axis_space \"world\" for one crystal filling the shape, or "
+                         "\"local\" for an axis that follows the surface");
+        defaults.log(props, ClassName);
     }
 
     /// eta_o, eta_e, kappa_o, kappa_e and optic_axis are differentiable in the JIT variants

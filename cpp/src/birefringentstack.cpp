@@ -34,7 +34,8 @@ Birefringent stack (:monosp:`birefringentstack`)
      wavelength over which the stack is integrated; 0 (or below 1e-12 of the wavelength) is the
      exact stack at the wavelength; at most a quarter of the wavelength. A band costs many exact
      evaluations of the stack (its round trips within the band's coherence length are resolved
-     by quadrature). (Default: 0)
+     by quadrature). In the RGB and mono variants a non-zero value is ignored with a warning.
+     (Default: 0)
    - |exposed|
 
  * - channel
@@ -124,7 +125,7 @@ public:
         m_exit_ior = props.has_property("exit_ior")
                          ? shim::parse_ior(props, "exit_ior", "air", ClassName)
                          : m_ext_ior;
-        m_filter_bandwidth = props.get<double>("filter_bandwidth", 0.0);
+        m_filter_bandwidth = shim::parse_filter_bandwidth<Spectrum>(props, ClassName);
         m_absorbing_exit = props.get<bool>("absorbing_exit", false);
         m_channel = shim::parse_channel<Spectrum>(props, ClassName);
         parameters_changed();

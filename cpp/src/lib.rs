@@ -14,7 +14,7 @@ mod shim {
     unsafe extern "C++" {
         include!("register.h");
 
-        /// Registers both plugins with Mitsuba's PluginManager.
+        /// Registers the three plugins with Mitsuba's PluginManager.
         fn register_plugins() -> Result<()>;
 
         /// The variants the plugins work in, comma-separated.

@@ -1,4 +1,4 @@
-/* Scene parameters shared by the two plugins: the material (a named crystal or constant
+/* Scene parameters shared by the plugins: the material (a named crystal or constant
  * indices, as the core's material table takes them), indices of refraction by number or by
  * Mitsuba's IOR names. Values are checked by the core (its messages name the parameter), not
  * here.
@@ -47,16 +47,37 @@ struct Defaults {
 
     void add(std::string note) { notes.push_back(std::move(note)); }
 
-    void log(const char *ClassName) const {
-        if (notes.empty())
+    /// Logs the notes, naming the object by its id where it has one (a dict's key, an XML
+    /// id: which layer of a stack, which of several plates). Not if a property was left unread:
+    /// Mitsuba's error about it follows the constructor, and a default it caused is no news
+    /// (`thicknes` misspelt gets that error alone, not first "thickness = 1 um").
+    void log(const Properties &props, const char *ClassName) const {
+        if (notes.empty() || !props.unqueried().empty())
             return;
         std::string all;
         for (const std::string &n : notes)
             all += (all.empty() ? "" : "; ") + n;
-        Log(Warn, "not given, so by default: %s. Give them to choose (and to silence this "
-                  "warning).", all);
+        std::string id(props.id());
+        std::string to = id.empty() ? "" : " to \"" + id + "\"";
+        Log(Warn, "not given%s, so by default: %s. Give them to choose (and to silence this "
+                  "warning).", to, all);
     }
 };
+
+/// `filter_bandwidth` (nm FWHM; default 0, the exact element at each wavelength): the band of
+/// the spectral variants. Elsewhere the element is integrated over colour channels in closed
+/// form and a band means nothing: a non-zero one is said to be ignored, not silently dropped.
+template <typename Spectrum>
+double parse_filter_bandwidth(const Properties &props, const char *ClassName) {
+    double fwhm = props.get<double>("filter_bandwidth", 0.0);
+    if constexpr (!is_spectral_v<Spectrum>)
+        if (fwhm != 0.0)
+            Log(Warn, "\"filter_bandwidth\" = %g nm is ignored in this variant, where the element "
+                      "is integrated over %s in closed form; it is the band around each sampled "
+                      "wavelength of the spectral variants (remove it, or render in one)",
+                fwhm, is_rgb_v<Spectrum> ? "the sRGB channels" : "its colour channel (\"channel\")");
+    return fwhm;
+}
 
 /// The isotropic glass of a plate given a stress `birefringence` but no material: Mitsuba's
 /// "bk7" (its ior.h), which is also `thindielectric`'s default `int_ior`.

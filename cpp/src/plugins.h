@@ -1,4 +1,4 @@
-/* What both plugins include: the parameters, the bridge to the core, the conversion of its
+/* What every plugin includes: the parameters, the bridge to the core, the conversion of its
  * lobes, and their registration with Mitsuba's PluginManager in the supported variants.
  */
 #pragma once
@@ -68,7 +68,7 @@ template <template <typename, typename> class Plugin> void register_plugin(const
         register_refusal(pm, name, v);
 }
 
-/// Host columns (indices into HostInputs) of what every query of both plugins reads: the active
+/// Host columns (indices into HostInputs) of what every query of the plugins reads: the active
 /// mask, the lobe-choosing sample, `si.wi` and, in the spectral variants, the `waves` sampled
 /// wavelengths from `first_wave` on.
 struct PathColumns {

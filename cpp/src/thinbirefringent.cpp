@@ -36,7 +36,9 @@ Birefringent plate (:monosp:`thinbirefringent`)
  * - optic_axis
    - |vector|
    - The optic axis in the local shading frame (x = dp/du, z = normal), any non-zero length; at
-     each point rotated about the normal by ``axis_angle``. (Default: ``[1, 0, 0]``)
+     each point rotated about the normal by ``axis_angle``. (Default: ``[1, 0, 0]``, said in a
+     warning at load for a birefringent plate given neither this nor ``axis_angle``: between
+     polarisers along x or y it changes nothing)
    - |exposed|, |differentiable|
 
  * - ext_ior
@@ -93,8 +95,9 @@ Birefringent plate (:monosp:`thinbirefringent`)
      wavelength over which the plate is integrated in closed form; 0 (or below 1e-12 of the
      wavelength) is the exact plate at the wavelength (the default: a band never paid at equal
      error in the scene benchmark); at most a quarter of the wavelength. Gradients (llvm_ad
-     variants) need 0: the band's closed form has no derivatives yet (docs/gradients.md).
-     (Default: 0)
+     variants) need 0: the band's closed form has no derivatives yet (docs/gradients.md). In the
+     RGB and mono variants, which integrate over channels, a non-zero value is ignored with a
+     warning. (Default: 0)
    - |exposed|
 
  * - channel
@@ -122,8 +125,8 @@ component 1 the transmission, which leaves in the direction Snell's law gives be
 ``eval_null_transmission`` (so that volpath reaches lights behind it), when
 ``exit_ior == ext_ior``; ``DeltaTransmission`` otherwise. Both carry the plate's full Mueller
 matrix with every internal reflection, from either side and in both transport modes (the
-physics is the core's ``bfr_plate_lobes``, ``bfr_plate_lobes_n`` and ``bfr_plate_lobes_rgb``;
-see docs/physics.md, sections 3 and 4). Lobes are sampled in proportion to their unpolarised
+physics is the core's ``sample_plate``, through ``render::plate::plate_lobes``; see
+docs/physics.md, sections 3 and 4). Lobes are sampled in proportion to their unpolarised
 weight. With ``absorbing_exit`` only component 0 remains, on the front side. Textures are
 evaluated with ``eval_1`` at the hit point (use ``raw="true"`` for data bitmaps).
 
@@ -168,9 +171,6 @@ public:
     using Answers = shim::Answers<Float, Spectrum>;
     using Vec3d = typename Answers::Vec3d;
 
-    /// Default `filter_bandwidth` (nm, FWHM) of the spectral variants.
-    static constexpr double DefaultFilterBandwidth = 0.0;
-
     /// Parameters of other plugins a Mitsuba user is likely to give a plate, and what to give.
     static constexpr shim::Foreign Foreign[] = {
         { "int_ior", "the plate's own index is eta_o and eta_e (equal for a glass plate) or "
@@ -208,13 +208,19 @@ public:
         if (props.has_property("axis_angle"))
             m_axis_angle = shim::scalar_texture<Float, Spectrum>(props, "axis_angle", 0.0,
                                                                  "degrees", ClassName);
-        m_filter_bandwidth = props.get<double>("filter_bandwidth", DefaultFilterBandwidth);
+        m_filter_bandwidth = shim::parse_filter_bandwidth<Spectrum>(props, ClassName);
         m_absorbing_exit = props.get<bool>("absorbing_exit", false);
         m_channel = shim::parse_channel<Spectrum>(props, ClassName);
         if (!props.has_property("thickness"))
             defaults.add("thickness = 1 um (thickness is in micrometres: a 3 mm plate is 3000)");
         parameters_changed();
-        defaults.log(ClassName);
+        if (!props.has_property("optic_axis") && !props.has_property("axis_angle") &&
+            !(m_material->is_isotropic(0) && !m_birefringence))
+            defaults.add("optic_axis = [1, 0, 0] in the shading frame (x = dp/du: on a "
+                         "rectangle the world's x), where between polarisers along x or y the "
+                         "plate changes nothing (crossed ones stay black); give optic_axis, "
+                         "e.g. [1, 1, 0] at 45 degrees, or axis_angle");
+        defaults.log(props, ClassName);
     }
 
     /// eta_o, eta_e, kappa_o, kappa_e, optic_axis and the textures' values are differentiable

@@ -7,7 +7,8 @@ Importing the package registers the plugins with Mitsuba's plugin manager::
     import mitsuba as mi
     import mitsuba_birefringent
     mi.set_variant("scalar_spectral_polarized")
-    plate = mi.load_dict({"type": "thinbirefringent", "material": "quartz", "thickness": 20.0})
+    plate = mi.load_dict({"type": "thinbirefringent", "material": "quartz", "thickness": 20.0,
+                          "optic_axis": [1, 1, 0]})
 
 They work in the variants listed in :data:`VARIANTS` (a cuda variant is refused with the llvm
 variant to use: at scene load, or by ``mi.set_variant`` on a machine without a CUDA device); in
@@ -30,6 +31,7 @@ import importlib.metadata
 from . import messages
 from .jit import evaluated_mode
 from .library import core_version, library_path, register, supported_variants
+from .names import PLUGINS
 
 __all__ = ["PLUGINS", "VARIANTS", "__version__", "library_path", "core_version", "register",
            "evaluated_mode", "render_analytic"]
@@ -40,9 +42,6 @@ try:
 except importlib.metadata.PackageNotFoundError:
     raise ImportError("mitsuba_birefringent is not installed (no distribution metadata): run "
                       "`pip install .` (or `make setup`) at the repository root") from None
-
-#: The BSDF plugin names this package registers.
-PLUGINS = ("thinbirefringent", "birefringentstack", "birefringent")
 
 register()
 

@@ -25,6 +25,7 @@ The render warns of both.
 
 from __future__ import annotations
 
+import contextlib
 import warnings
 from typing import Any, Iterator
 
@@ -35,9 +36,10 @@ try:
 except ImportError:  # the plugins need no numpy; channel renders do
     raise ImportError("mitsuba_birefringent.render_analytic needs numpy: pip install numpy") from None
 
-from .channel_scene import PLUGIN_TYPES, ChannelScene
+from .channel_scene import ChannelScene
 from .jit import evaluated_mode
 from .library import channel_matrix
+from .names import PLUGINS
 
 #: The variant of the passes (the one polarized channel variant Mitsuba's wheel ships).
 VARIANT = "llvm_ad_mono_polarized"
@@ -67,7 +69,7 @@ def render_analytic(scene: dict, spp: int = 16, weights: str = "srgb-d65",
     mi.set_variant(VARIANT)
     try:
         with evaluated_mode():
-            images = [render_pass(p, spp, seed) for p in passes]
+            images = [render_pass(p, spp, seed, quiet=k > 0) for k, p in enumerate(passes)]
     finally:
         if previous is not None:
             mi.set_variant(previous)
@@ -81,14 +83,29 @@ def channel_passes(scene: dict, weights: str) -> list[dict]:
             for k, c in enumerate(CHANNELS[weights])]
 
 
-def render_pass(scene: dict, spp: int, seed: int) -> dict[str, np.ndarray]:
-    """One pass: the film's channels by name, each (H, W)."""
-    loaded = mi.load_dict(scene)
+def render_pass(scene: dict, spp: int, seed: int, quiet: bool = False) -> dict[str, np.ndarray]:
+    """One pass: the film's channels by name, each (H, W). `quiet`: the scene is loaded without
+    its warnings (those of the first pass's load: the passes differ only in their channel), so
+    that each is printed once, not once per pass; errors are still raised."""
+    with warnings_off() if quiet else contextlib.nullcontext():
+        loaded = mi.load_dict(scene)
     mi.render(loaded, spp=spp, seed=seed)
     bitmap = loaded.sensors()[0].film().bitmap()
     names = [bitmap.struct_()[i].name for i in range(bitmap.channel_count())]
     data = np.array(bitmap, dtype=np.float64).reshape(bitmap.height(), bitmap.width(), len(names))
     return {name: data[..., i] for i, name in enumerate(names)}
+
+
+@contextlib.contextmanager
+def warnings_off() -> Iterator[None]:
+    """Mitsuba's log at errors only, restored afterwards."""
+    logger = mi.logger()
+    level = logger.log_level()
+    logger.set_log_level(mi.LogLevel.Error)
+    try:
+        yield
+    finally:
+        logger.set_log_level(level)
 
 
 def stokes_component(image: dict[str, np.ndarray], s: int) -> np.ndarray | None:
@@ -115,7 +132,7 @@ def plugin_nodes(node: Any) -> Iterator[dict]:
     """Every dict of the scene whose type is one of the package's plugins (a stack's layers are
     part of the stack, not plates of their own)."""
     if isinstance(node, dict):
-        if node.get("type") in PLUGIN_TYPES:
+        if node.get("type") in PLUGINS:
             yield node
             if node["type"] == "birefringentstack":
                 return

@@ -26,9 +26,7 @@ from typing import Any
 import mitsuba as mi
 import numpy as np
 
-#: The plugins of this package (their parameters are physical scalars: never rewritten; a
-#: stack's nested plates are its layers, which it integrates over the channel itself).
-PLUGIN_TYPES = ("thinbirefringent", "birefringent", "birefringentstack")
+from .names import PLUGINS
 
 #: Mitsuba 3.9.1's emitter plugins whose spectrum a scene gives (a texture or spectrum).
 EMITTER_TYPES = ("area", "point", "spot", "constant", "envmap", "directional", "directionalarea",
@@ -73,7 +71,9 @@ class ChannelScene:
 
     def _dict(self, node: dict, path: str, emitter: bool) -> dict:
         kind = node.get("type")
-        if kind in PLUGIN_TYPES:
+        # The package's plugins: their parameters are physical scalars, never rewritten (a
+        # stack's nested plates are its layers, which it integrates over the channel itself).
+        if kind in PLUGINS:
             if "channel" in node:
                 raise ValueError(f"{path}: \"channel\" is set by the channel render; remove it")
             return {**node, "channel": self.channel}

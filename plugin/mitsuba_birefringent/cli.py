@@ -1,5 +1,5 @@
 """``mitsuba-birefringent``: Mitsuba 3's command-line renderer for XML scenes, with the plugins
-``thinbirefringent`` and ``birefringent`` registered.
+``thinbirefringent``, ``birefringentstack`` and ``birefringent`` registered.
 
 Mitsuba's own ``mitsuba`` command cannot render a scene that uses them (it reports
 ``Plugin "birefringent" not found``: it only knows the plugins shipped in its wheel). This
@@ -8,9 +8,13 @@ command takes the options of ``mitsuba`` 3.9.1 with the same meaning::
     mitsuba-birefringent -m scalar_spectral_polarized -D spp=64 -o out.exr scene.xml
 
 and renders each scene with its own integrator, writing the film of the chosen sensor (by
-default next to the scene file, with the film's extension, as ``mitsuba`` does). One option is
-added: ``--spp N`` overrides the sampler's sample count. ``-V`` (the LLVM vector width) is not
-supported. In the llvm variants scenes render in Dr.Jit's evaluated mode, which the plugins
+default next to the scene file, with the film's extension, as ``mitsuba`` does). ``-o`` writes
+the format its extension names, where ``mitsuba`` would write its film's format whatever the
+extension: ``.exr`` the film (every channel), ``.hdr`` or ``.pfm`` its RGB (or luminance)
+channels in floating point, ``.png``, ``.jpg`` or ``.jpeg`` those in 8-bit sRGB (clamped to
+[0, 1], as ``mi.util.convert_to_bitmap`` writes them); another extension is refused before the
+render. One option is added: ``--spp N`` overrides the sampler's sample count. ``-V`` (the LLVM
+vector width) is not supported. In the llvm variants scenes render in Dr.Jit's evaluated mode, which the plugins
 need (``mitsuba_birefringent.evaluated_mode``).
 """
 
@@ -25,19 +29,25 @@ import drjit as dr
 import mitsuba as mi
 
 import mitsuba_birefringent
+from mitsuba_birefringent.names import listed
 
 #: Dr.Jit flags that mitsuba's `-O <level>` switches on successively (off above the level).
 OPTIMIZATION_FLAGS = ("MergeFunctions", "ConstantPropagation", "ValueNumbering", "OptimizeCalls",
                       "OptimizeLoops")
 #: Mitsuba's log levels for 0, 1 and 2 or more `-v`.
 LOG_LEVELS = ("Info", "Debug", "Trace")
+#: What `-o` writes by its extension: the film itself (all its channels), its RGB or luminance
+#: channels in floating point, or those in 8-bit sRGB.
+FILM_EXTENSIONS = (".exr",)
+FLOAT_EXTENSIONS = (".hdr", ".pfm")
+SRGB_EXTENSIONS = (".png", ".jpg", ".jpeg")
 
 
 def parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="mitsuba-birefringent",
-        description="Render Mitsuba 3 XML scenes with the birefringent BSDFs thinbirefringent and "
-                    "birefringent registered (the options of Mitsuba's `mitsuba` command).")
+        description=f"Render Mitsuba 3 XML scenes with the birefringent BSDFs {listed()} "
+                    "registered (the options of Mitsuba's `mitsuba` command).")
     p.add_argument("scenes", nargs="+", metavar="scene.xml", help="one or more scene XML files")
     p.add_argument("-m", "--mode", metavar="VARIANT",
                    help="the Mitsuba variant (default: %(default)s, the first of the variants the "
@@ -54,8 +64,9 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("-a", dest="paths", action="append", default=[], metavar="PATH1;PATH2",
                    help="add entries to the resource search path")
     p.add_argument("-o", "--output", metavar="FILENAME",
-                   help="write the image to this file (default: the scene's path with the "
-                        "film's extension)")
+                   help="write the image to this file, in the format its extension names: "
+                        ".exr (the film), .hdr, .pfm (its RGB channels), .png, .jpg (8-bit sRGB) "
+                        "(default: the scene's path with the film's extension)")
     p.add_argument("--spp", type=int, metavar="N",
                    help="samples per pixel, overriding the scene's sampler (not in `mitsuba`)")
     jit = p.add_argument_group("JIT (llvm/cuda) variants only")
@@ -124,7 +135,35 @@ def render_file(path: Path, params: dict[str, str], args: argparse.Namespace) ->
     with thread_count(args.threads), mitsuba_birefringent.evaluated_mode():
         integrator.render(scene, sensor=args.sensor, seed=0, spp=args.spp or 0, develop=False,
                           evaluate=True)
-    sensors[args.sensor].film().write(str(args.output or path))
+    film = sensors[args.sensor].film()
+    if args.output is None:
+        film.write(str(path))  # the film's own format, next to the scene (as `mitsuba`)
+    else:
+        write_image(film, Path(args.output))
+
+
+def check_output(output: str | None) -> None:
+    """Refuses an `-o` whose extension names no format this command writes (before rendering)."""
+    if output is None:
+        return
+    ext = Path(output).suffix.lower()
+    if ext not in FILM_EXTENSIONS + FLOAT_EXTENSIONS + SRGB_EXTENSIONS:
+        raise ValueError(f"-o {output}: cannot write {ext or 'a file without extension'}; give "
+                         ".exr (the film, every channel), .hdr or .pfm (its RGB channels) or "
+                         ".png, .jpg (8-bit sRGB)")
+
+
+def write_image(film, path: Path) -> None:
+    """Writes `film` to `path` in the format its extension names (module docstring)."""
+    ext = path.suffix.lower()
+    if ext in FILM_EXTENSIONS:
+        film.write(str(path))
+        return
+    colour = dict(film.bitmap().split())["<root>"]  # RGB (or Y in the mono variants)
+    if ext in FLOAT_EXTENSIONS:
+        colour.write(str(path))
+    else:
+        mi.util.convert_to_bitmap(colour).write(str(path))
 
 
 @contextlib.contextmanager
@@ -151,6 +190,7 @@ def run(args: argparse.Namespace) -> None:
     if args.spp is not None and args.spp < 1:
         raise ValueError(f"--spp must be at least 1, got {args.spp}")
     params = defines(args.define)
+    check_output(args.output)
     set_jit_flags(args)
     mi.set_variant(args.mode)
     mi.set_log_level(getattr(mi.LogLevel, LOG_LEVELS[min(args.verbose, 2)]))

@@ -46,7 +46,7 @@ def load() -> ctypes.CDLL:
 
 
 def register() -> None:
-    """Registers (again) both plugins in every variant. Called on import."""
+    """Registers (again) the three plugins in every variant. Called on import."""
     lib = load()
     buf = ctypes.create_string_buffer(1024)
     if lib.bfr_mitsuba_register(buf, len(buf)) != 0:

@@ -22,8 +22,7 @@ from typing import Any, Callable
 
 import mitsuba
 
-#: The class tags of the plugins' messages (Mitsuba's Throw prefixes them with "[Class] ").
-TAGS = ("[ThinBirefringent] ", "[Birefringent] ")
+from .names import TAGS, listed
 
 #: Marks the wrappers, so that installing twice (a reload) does not wrap them again.
 MARK = "_mitsuba_birefringent_wrapper"
@@ -43,8 +42,8 @@ def plugin_message(error: BaseException | None) -> str | None:
 
 def cuda_refusal(variant: str, supported: tuple[str, ...]) -> str:
     """The plugins' refusal of a CUDA variant (the text of cpp/src/plugins.h's)."""
-    return (f'variant "{variant}" is not supported by thinbirefringent and birefringent (their '
-            f'core computes on the CPU); use "llvm{variant[4:]}", or any of ' + ", ".join(supported))
+    return (f'variant "{variant}" is not supported by {listed()} (their core computes on the '
+            f'CPU); use "llvm{variant[4:]}", or any of ' + ", ".join(supported))
 
 
 def wrap_render(render: Callable[..., Any]) -> Callable[..., Any]:

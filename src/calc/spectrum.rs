@@ -1,6 +1,6 @@
 //! `birefringence slab` with a `spectrum`: Mueller matrices integrated over camera channel
 //! weights or over a Gaussian band, in closed form ("analytic": what the renderer uses, to the
-//! perceptual budget of `spectral::channels` over channels; "exact": every approximation below
+//! perceptual budget of `spectral::budget` over channels; "exact": every approximation below
 //! 1e-5 of the fitted weights) or by dense quadrature of the exact slab ("quadrature", the
 //! reference).
 

@@ -21,7 +21,7 @@
 //! isotropic plate is two Airy etalons ([`crate::plate::etalon`], exact for Gaussians), and a narrow
 //! Gaussian (σ ≤ [`NARROW_BAND`] μ) through any plate is the matrix etalon of
 //! [`crate::spectral::narrow`] where its residual phases are resolved by a few nodes. The
-//! shared quadrature of [`integrate_set`] interpolates a dispersive plate's interface blocks
+//! shared quadrature of [`integrate_set_exact`] interpolates a dispersive plate's interface blocks
 //! across the band ([`crate::spectral::interpolate`]) and sizes its rule order by order
 //! ([`crate::spectral::shared`]).
 

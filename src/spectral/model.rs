@@ -7,8 +7,8 @@
 //!   Gaussian.
 //! * Any other plate is the general slab ([`crate::plate::slab`]) at one wavelength; over a
 //!   band, the closed forms and quadratures of [`crate::spectral::integrate`]; over a channel
-//!   set, the path-class fringe integration of [`crate::spectral::channels`] (held to the
-//!   perceptual budget stated there), or, on request or where that method declines (more
+//!   set, the method [`crate::spectral::route`] chooses (held to the perceptual
+//!   budget of [`crate::spectral::budget`]), or, on request or where that method declines (more
 //!   coherent orders than it sums: thin plates of high index near grazing incidence), the exact
 //!   rule of [`integrate_set_exact`] (every approximation below 1e-5 of the fitted weights).
 
@@ -32,7 +32,7 @@ use std::cell::OnceCell;
 /// How exactly a channel set is integrated.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Accuracy {
-    /// The perceptual budget of [`crate::spectral::channels`] (mean CIEDE2000 0.1, worst 0.5
+    /// The perceptual budget of [`crate::spectral::budget`] (mean CIEDE2000 0.1, worst 0.5
     /// against the tabulated weights, measured in `tests/spectral_rgb.rs`): what renders use.
     Perceptual,
     /// Every approximation below 1e-5 of the fitted weights (the rule the perceptual one is

@@ -127,6 +127,9 @@ def main() -> None:
     a = ap.parse_args()
     mi.set_variant(VARIANT)
     import mitsuba_birefringent  # noqa: F401  (registers the plugins)
+    import llvm_target
+
+    llvm_target.apply()
 
     if a.what == "threads":
         r = threads(a.counts)

@@ -121,7 +121,7 @@ def test_channel_pass_rooms_are_the_pass_render_analytic_renders(variant, monkey
     key = "anisotropic/quartz_plates_50um"
     room = B.room(mi, B.CONFIGS[B.OVERHEAD_PAIRS[key].ours](mi))
     loaded = []
-    monkeypatch.setattr(analytic, "render_pass", lambda d, spp, seed: loaded.append(d) or {})
+    monkeypatch.setattr(analytic, "render_pass", lambda d, spp, seed, quiet=False: loaded.append(d) or {})
     monkeypatch.setattr(analytic, "assemble", lambda images, to_srgb: None)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # it warns of the three plates (side by side here: exact)

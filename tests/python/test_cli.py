@@ -98,6 +98,31 @@ def test_search_path_and_default_output(tmp_path):
     assert (tmp_path / "disk.exr").is_file()
 
 
+def test_output_is_written_in_the_format_its_extension_names(tmp_path):
+    """`-o` writes what it names (Mitsuba's `mitsuba` writes its film's EXR whatever the
+    extension): the EXR of the film, and, from the same render (seed 0), its RGB channels as
+    8-bit sRGB in PNG (what mi.util.convert_to_bitmap makes of them, pixel for pixel) and in
+    floating point in .pfm (the EXR's values as the film stores them, half floats)."""
+    xml = SCENES / "waveplates.xml"
+    size = ["-m", "scalar_spectral_polarized", "-D", "width=12", "-D", "height=5", "--spp", "2"]
+    for name in ("out.exr", "out.png", "out.pfm"):
+        result = run(*size, "-o", str(tmp_path / name), str(xml))
+        assert result.returncode == 0, result.stderr + result.stdout
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.exr", "out.pfm", "out.png"]
+    mi.set_variant("scalar_rgb")
+    exr = dict(mi.Bitmap(str(tmp_path / "out.exr")).split())["<root>"]
+    png = mi.Bitmap(str(tmp_path / "out.png"))
+    assert png.component_format() == mi.Struct.Type.UInt8 and png.srgb_gamma()
+    want = np.array(mi.util.convert_to_bitmap(np.array(exr)))
+    assert np.array(want).mean() > 10, "a black image"
+    assert np.abs(np.array(png).astype(int) - want.astype(int)).max() <= 1
+    pfm = np.array(mi.Bitmap(str(tmp_path / "out.pfm")))
+    np.testing.assert_allclose(pfm, np.array(exr, dtype=np.float32), rtol=1e-3, atol=1e-4)
+    refused = run(*size, "-o", str(tmp_path / "out.tiff"), str(xml))
+    assert refused.returncode == 1 and "-o" in refused.stderr and ".png" in refused.stderr
+    assert not (tmp_path / "out.tiff").exists() and not (tmp_path / "out.exr.tiff").exists()
+
+
 @pytest.mark.parametrize("args, message", [
     (["-D", "width"], "expected key=value"),
     (["-s", "1"], "sensor index 1 is out of bounds"),

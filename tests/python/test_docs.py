@@ -87,9 +87,11 @@ def source_names(path: pathlib.Path) -> tuple[set[str], set[str]]:
     read = r'(?:props\.\w+(?:<[^>]*>)?\(|(?:parse_ior|scalar_texture<[^>]*>)\(\s*props,\s*)\s*"(\w+)"'
     names = set(re.findall(read, source))
     common = (path.parent / "params.h").read_text()
-    # The parsers of params.h read properties too: the material, the channel.
+    # The parsers of params.h read properties too: the material, the channel, the band.
     for call, definition in (("parse_material(props", "inline MaterialParams parse_material"),
-                             ("parse_channel<Spectrum>(props", "std::string parse_channel")):
+                             ("parse_channel<Spectrum>(props", "std::string parse_channel"),
+                             ("parse_filter_bandwidth<Spectrum>(props",
+                              "double parse_filter_bandwidth")):
         if call in source:
             body = common[common.index(definition):]
             names |= set(re.findall(read, body[:body.index("\n}\n")]))
@@ -161,3 +163,54 @@ def test_benchmark_page_and_summary_are_generated_from_the_results(tmp_path):
     written = re.sub(r"\]\([^)\s]*?bench/", "](../bench/", page.read_text())
     assert written == (DOCS / "benchmarks.md").read_text()
     assert readme.read_text() == (ROOT / "README.md").read_text()
+
+
+#: Numbers as the documents write them.
+NUMBER_WORDS = {1: "one", 2: "two", 3: "three", 4: "four", 5: "five", 6: "six"}
+#: A count of plugins in prose ("three BSDF plugins", "both plugins").
+PLUGIN_COUNT = re.compile(r"\b(one|two|three|four|five|six|both)\s+(?:Mitsuba\s+)?(?:BSDF\s+)?"
+                          r"plugins\b", re.IGNORECASE)
+
+
+def test_the_docs_count_and_name_every_plugin():
+    """README.md, plugin/README.md and docs/architecture.md name every plugin the package
+    registers and count them right (no "two plugins" left when a third is added); so do the
+    command's --help and the refusal of a cuda variant."""
+    import mitsuba as mi
+
+    mi.set_variant("scalar_rgb")
+    import mitsuba_birefringent
+    from mitsuba_birefringent import messages
+
+    plugins = mitsuba_birefringent.PLUGINS
+    for name in plugins:  # each is registered under that name
+        assert mi.PluginManager.instance().plugin_type(name) == mi.ObjectType.BSDF, name
+    count = NUMBER_WORDS[len(plugins)]
+    for doc in (ROOT / "README.md", ROOT / "plugin" / "README.md", DOCS / "architecture.md"):
+        text = doc.read_text(encoding="utf-8")
+        for name in plugins:
+            assert f"`{name}`" in text, f"{doc.name} does not name {name}"
+        said = [m.group(1).lower() for m in PLUGIN_COUNT.finditer(text)]
+        assert count in said, f"{doc.name} does not say {count} plugins"
+        assert set(said) == {count}, f"{doc.name} counts the plugins as {sorted(set(said))}"
+    help_text = subprocess.run([str(ROOT / ".venv" / "bin" / "mitsuba-birefringent"), "--help"],
+                               capture_output=True, text=True, timeout=120).stdout
+    refusal = messages.cuda_refusal("cuda_ad_rgb", mitsuba_birefringent.VARIANTS)
+    for name in plugins:
+        assert name in " ".join(help_text.split()), f"--help does not name {name}"
+        assert name in refusal, refusal
+
+
+def test_readme_states_the_number_of_pytest_tests():
+    """README.md's `make test` row states how many pytest tests there are: the number pytest
+    collects (a test added or removed without the README fails here)."""
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    stated = re.findall(r"(\d+) pytest tests", readme)
+    assert len(stated) == 1, f"README.md states the pytest count {len(stated)} times"
+    out = subprocess.run([sys.executable, "-m", "pytest", "--collect-only", "-q",
+                          "-p", "no:cacheprovider", str(ROOT / "tests" / "python")],
+                         capture_output=True, text=True, timeout=600, cwd=ROOT)
+    collected = re.search(r"^(\d+) tests? collected", out.stdout, re.MULTILINE)
+    assert collected, out.stdout[-2000:] + out.stderr[-2000:]
+    assert int(stated[0]) == int(collected.group(1)), (
+        f"README.md says {stated[0]} pytest tests; pytest collects {collected.group(1)}")
