@@ -108,13 +108,18 @@ def ortho_sensor(width: int, height: int, spp: int, half_x: float, half_y: float
     return sensor
 
 
-def backlight(z: float, half: float, scale: float = 1.0) -> dict:
-    """A large D65 area light facing +z (white light from behind the optical train)."""
-    return {
+def backlight(z: float, half: float, scale: float = 1.0, black: bool = False) -> dict:
+    """A large D65 area light facing +z (white light from behind the optical train). Mitsuba
+    gives a shape without a BSDF a grey diffuse one (reflectance 0.5), which sends light that the
+    optics reflect back down into the view again; `black` makes the light box reflect nothing."""
+    light = {
         "type": "rectangle",
         "to_world": T().translate([0, 0, z]).scale([half, half, 1.0]),
         "emitter": {"type": "area", "radiance": {"type": "d65", "scale": scale}},
     }
+    if black:
+        light["bsdf"] = {"type": "diffuse", "reflectance": 0.0}
+    return light
 
 
 def pixel_centres(n: int, half: float) -> np.ndarray:
