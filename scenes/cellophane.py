@@ -38,12 +38,13 @@ plate on every path, so the channel render is exact and has no colour noise.
 
 from __future__ import annotations
 
+import functools
 import math
 import typing
 
 import numpy as np
 
-from _common import backlight, data_texture, layer, ortho_sensor
+from _common import T, backlight, data_texture, layer, ortho_sensor
 
 VARIANTS = ("scalar_spectral_polarized",)
 
@@ -105,38 +106,45 @@ def texel_centres() -> tuple[np.ndarray, np.ndarray]:
     return np.meshgrid(xs, ys)
 
 
-def overlaps(a: Strip, b: Strip) -> bool:
-    """Whether two strips share a texel."""
+@functools.lru_cache(maxsize=None)
+def edge_distances() -> np.ndarray:
+    """(strips, rows, columns): each texel centre's signed distance to each strip's edge."""
     x, y = texel_centres()
-    return bool((a.inside(x, y) & b.inside(x, y)).any())
+    return np.array([s.edge_distance(x, y) for s in STRIPS])
 
 
-def slots(strips: typing.Sequence[Strip] = STRIPS) -> list[int]:
-    """The stack layer ("slot") of each strip, counted from the bottom: one more than the highest
-    slot of the strips laid before it that it overlaps (so at every point the layers keep the
-    order in which the strips were laid, and overlapping strips never share a slot)."""
+@functools.lru_cache(maxsize=None)
+def coverage() -> np.ndarray:
+    """(strips, rows, columns): whether each texel centre lies inside each strip of STRIPS."""
+    return edge_distances() > 0
+
+
+def slots() -> list[int]:
+    """The stack layer ("slot") of each strip of STRIPS, counted from the bottom: one more than
+    the highest slot of the strips laid before it that it overlaps (so at every point the layers
+    keep the order in which the strips were laid, and overlapping strips never share a slot)."""
+    inside = coverage()
     out: list[int] = []
-    for k, s in enumerate(strips):
-        below = [out[j] for j in range(k) if overlaps(strips[j], s)]
+    for k in range(len(STRIPS)):
+        below = [out[j] for j in range(k) if (inside[j] & inside[k]).any()]
         out.append(max(below) + 1 if below else 0)
     return out
 
 
-def slot_textures(strips: typing.Sequence[Strip] = STRIPS) -> list[tuple[np.ndarray, np.ndarray]]:
-    """Per slot, from the bottom: (coverage, angle) over the texels; coverage 1 inside a strip of
-    the slot and 0 elsewhere, angle the strip's angle there (0 elsewhere)."""
-    x, y = texel_centres()
-    assigned = slots(strips)
+def slot_textures() -> list[tuple[np.ndarray, np.ndarray]]:
+    """Per slot, from the bottom: (thickness fraction, angle) over the texels: 1 inside a strip
+    of the slot and 0 elsewhere, the strip's angle there (0 elsewhere)."""
+    inside = coverage()
+    assigned = slots()
     out = []
     for slot in range(max(assigned) + 1):
-        coverage = np.zeros(x.shape, dtype=np.float32)
-        angle = np.zeros(x.shape, dtype=np.float32)
-        for s, k in zip(strips, assigned):
-            if k == slot:
-                inside = s.inside(x, y)
-                coverage[inside] = 1.0
-                angle[inside] = s.angle_deg
-        out.append((coverage, angle))
+        fraction = np.zeros(inside.shape[1:], dtype=np.float32)
+        angle = np.zeros(inside.shape[1:], dtype=np.float32)
+        for k, s in enumerate(STRIPS):
+            if assigned[k] == slot:
+                fraction[inside[k]] = 1.0
+                angle[inside[k]] = s.angle_deg
+        out.append((fraction, angle))
     return out
 
 
@@ -151,8 +159,8 @@ def stack(filter_bandwidth: float = 0.0, **film_options) -> dict:
     """The `birefringentstack` of every slot, from the exterior (the camera's side: the top slot)
     down."""
     layers = {}
-    for k, (coverage, angle) in reversed(list(enumerate(slot_textures()))):
-        layers[f"slot_{k}"] = dict(film(**film_options), thickness=data_texture(coverage, "nearest"),
+    for k, (fraction, angle) in reversed(list(enumerate(slot_textures()))):
+        layers[f"slot_{k}"] = dict(film(**film_options), thickness=data_texture(fraction, "nearest"),
                                    axis_angle=data_texture(angle, "nearest"))
     return {"type": "birefringentstack", "filter_bandwidth": filter_bandwidth, **layers}
 
@@ -167,7 +175,7 @@ def probe(strips: tuple[int, ...]) -> tuple[float, float, float]:
     """The texel centre covered by exactly `strips` (indices into STRIPS, any order) that lies
     farthest from every strip edge: (x, y, its distance to the nearest edge)."""
     x, y = (a.ravel() for a in texel_centres())
-    distance = np.stack([s.edge_distance(x, y) for s in STRIPS])
+    distance = edge_distances().reshape(len(STRIPS), -1)
     wanted = np.zeros(len(STRIPS), dtype=bool)
     wanted[list(strips)] = True
     exact = np.all((distance > 0) == wanted[:, None], axis=0)
@@ -187,6 +195,16 @@ PROBES = {
     "60 deg under 15 deg": (4, 6),
     "two at 60 deg under -35 deg": (4, 5, 7),
 }
+
+
+def strips_as_shapes(bsdf: dict) -> dict:
+    """Each strip as a rectangle of its own with `bsdf`, 1e-3 apart in height in laying order
+    (the scene as one would build it with a plugin that takes no textures of thickness: the
+    benchmark's `thindielectric` counterpart, bench/scenes.py)."""
+    return {f"strip_{k}": {
+        "type": "rectangle", "bsdf": bsdf,
+        "to_world": T().translate([s.x, s.y, 1e-3 * k]).rotate([0, 0, 1], s.angle_deg)
+        .scale([s.half_length, s.half_width, 1.0])} for k, s in enumerate(STRIPS)}
 
 
 def scene(width: int = 360, height: int = 240, spp: int = 16, filter_bandwidth: float = 0.0,

@@ -4,8 +4,9 @@ channels and against an independent transfer-matrix calculation.
 
 What is rendered: at each probe of `cellophane.PROBES` (a point under a known set of strips, at
 least 0.08 scene units from every strip edge) the scene seen through a 2 x 2 pixel window 0.04
-units wide, by `render_analytic` (srgb-d65 channels; the stack is the one plate on the path, so
-the channel render is exact), 1024 spp per pass with the multijitter sampler.
+units wide (one orthographic camera per probe, all on one film: a `batch` sensor), by
+`render_analytic` (srgb-d65 channels; the stack is the one plate on the path, so the channel
+render is exact), 1024 spp per pass with the multijitter sampler.
 
 References:
 1. the calculator (`birefringence stack`, the core's channel integration over srgb-d65: the same
@@ -70,15 +71,26 @@ def calculator_pixel(top_first):
     return 0.25 * (m[:, 0, 0] + a * m[:, 0, 1] + b * m[:, 1, 0] + a * b * m[:, 1, 1])
 
 
-def render_probe(x, y):
-    """The probe's 2 x 2 window by channels: (channel values, linear sRGB), each the window's mean."""
+@pytest.fixture(scope="module")
+def rendered():
+    """Every probe's window by channels, in one render (a `batch` sensor: an orthographic camera
+    per probe, side by side on one film): name -> (channel values, linear sRGB), each the mean of
+    the probe's 2 x 2 pixels."""
+    mi.set_variant("scalar_spectral_polarized")
+    names = list(cellophane.PROBES)
     d = cellophane.scene(width=2, height=2, spp=SPP)
-    d["sensor"]["to_world"] = (T().look_at(origin=[x, y, 10], target=[x, y, 0], up=[0, 1, 0])
-                               @ T().scale([WINDOW / 2, WINDOW / 2, 1]))
-    d["sensor"]["sampler"]["type"] = "multijitter"
+    cameras = {}
+    for k, name in enumerate(names):
+        x, y, _ = cellophane.probe(cellophane.PROBES[name])
+        cameras[f"probe_{k}"] = {"type": "orthographic", "to_world": T().look_at(
+            origin=[x, y, 10], target=[x, y, 0], up=[0, 1, 0]) @ T().scale([WINDOW / 2, WINDOW / 2, 1])}
+    d["sensor"] = {"type": "batch", **cameras,
+                   "film": {"type": "hdrfilm", "width": 2 * len(names), "height": 2,
+                            "rfilter": {"type": "box"}, "pixel_format": "rgb"},
+                   "sampler": {"type": "multijitter", "sample_count": SPP}}
     out = mb.render_analytic(d, spp=SPP, seed=3)
-    return (np.asarray(out["channels"], float).reshape(-1, 3).mean(axis=0),
-            np.asarray(out["rgb"], float).reshape(-1, 3).mean(axis=0))
+    window = lambda a, k: np.asarray(a, float)[:, 2 * k: 2 * k + 2].reshape(-1, 3).mean(axis=0)
+    return {name: (window(out["channels"], k), window(out["rgb"], k)) for k, name in enumerate(names)}
 
 
 def test_slots_keep_the_laying_order():
@@ -113,7 +125,7 @@ def weights():
 
 
 @pytest.mark.parametrize("name", list(cellophane.PROBES))
-def test_probe_colour(name, weights):
+def test_probe_colour(name, weights, rendered):
     lam, w = weights
     mi.set_variant("scalar_spectral_polarized")
     x, y, clearance = cellophane.probe(cellophane.PROBES[name])
@@ -121,12 +133,12 @@ def test_probe_colour(name, weights):
     top_first = cellophane.covering(np.array([x]), np.array([y]))[0]
     assert sorted(top_first) == sorted(cellophane.PROBES[name])
 
-    channels, rgb = render_probe(x, y)
+    channels, rgb = rendered[name]
     calc = calculator_pixel(top_first)
     tm = w.T @ so.between_polarisers(so.stack_jones(film_layers(top_first), lam), 0.0, 90.0)
     print(f"{name}: render {np.round(channels, 5)}, calculator {np.round(calc, 5)}, transfer matrix "
           f"{np.round(tm, 5)} (render's sRGB {np.round(rgb, 5)})")
-    if np.abs(calc).max() < 1e-6:  # the cancellation: black in every reference
+    if np.abs(calc).max() < 1e-6:  # the cancellation: black in every reference (float32: 1e-6)
         assert np.abs(channels).max() < 1e-6 and np.abs(tm).max() < 1e-6, (channels, tm)
         return
     # Brightness: the choice's rounding (module docstring) and float32.
