@@ -177,5 +177,22 @@ def figure(path, size: int = 65) -> None:
     plt.close(fig)
 
 
+def main() -> None:
+    import argparse
+    import pathlib
+
+    p = argparse.ArgumentParser(description="Plots the retardance of the quartz plate and of "
+                                "Mitsuba's retarder against the angle of incidence (`figure`).")
+    p.add_argument("--out", type=pathlib.Path, default=pathlib.Path("out/plots"))
+    a = p.parse_args()
+    a.out.mkdir(parents=True, exist_ok=True)
+    figure(a.out / "retarder_field_retardance.png")
+    print(a.out / "retarder_field_retardance.png")
+
+
 #: Gallery options (scenes/gallery.py): a channel render (`render_analytic`), no colour noise.
 GALLERY = {"analytic": True, "spp": 16}
+
+
+if __name__ == "__main__":
+    main()

@@ -128,3 +128,7 @@ def scene(width: int = 360, height: int = 240, spp: int = 32, filter_bandwidth: 
                             centre_x=-VIEW_X / 2 if half else 0.0)
     return d
 
+
+#: Gallery options (scenes/gallery.py): a channel render (`render_analytic`: no colour noise;
+#: spectral sampling left 3.6 % of brightness and 1.1 % of chromaticity noise per pixel at 16 spp), docs/scenes.md.
+GALLERY = {"analytic": True, "spp": 16}
