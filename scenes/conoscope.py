@@ -29,7 +29,7 @@ core's catalogue; with the axis tilted by 20 degrees the cross's centre lies whe
 sin i = n_o sin 20 degrees says.
 
 Variant: scalar_spectral_polarized; the gallery renders it by colour channels (the plate is the
-one plate on every path).
+one plate on every path). scenes/conoscope.xml is the same scene at its defaults.
 """
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ import math
 
 import numpy as np
 
-from _common import T, backlight, layer, monochromatic_srf
+from _common import backlight, layer, lens_sensor
 
 VARIANTS = ("scalar_spectral_polarized",)
 
@@ -84,25 +84,10 @@ def scene(width: int = 320, height: int = 320, spp: int = 16, filter_bandwidth: 
     rings (a 1 mm etalon's). `crop` = (offset_x, offset_y, width, height) renders only that
     window of the film.
     """
-    if wavelength_nm is not None:
-        film = {"type": "specfilm", "band": monochromatic_srf(wavelength_nm)}
-    else:
-        film = {"type": "hdrfilm", "pixel_format": "rgb"}
-    film.update({"width": width, "height": height, "rfilter": {"type": "box"}})
-    if crop is not None:
-        film.update({"crop_offset_x": crop[0], "crop_offset_y": crop[1], "crop_width": crop[2],
-                     "crop_height": crop[3]})
     return {
         "type": "scene",
         "integrator": {"type": "volpath", "max_depth": 8},
-        "sensor": {
-            "type": "perspective",
-            "fov": fov_deg,
-            "fov_axis": "x",
-            "to_world": T().look_at(origin=[0, 0, CAMERA_HEIGHT], target=[0, 0, 0], up=[0, 1, 0]),
-            "film": film,
-            "sampler": {"type": "independent", "sample_count": spp},
-        },
+        "sensor": lens_sensor(width, height, spp, fov_deg, CAMERA_HEIGHT, wavelength_nm, crop=crop),
         "light": backlight(-1.0, HALF, black=True),
         # Mitsuba's polarizer transmits along -theta (see scenes/_common.py).
         "polarizer": layer(-0.5, HALF, HALF, {"type": "polarizer", "theta": -polarizer_deg}),

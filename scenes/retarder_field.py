@@ -34,7 +34,7 @@ import math
 
 import numpy as np
 
-from _common import T, backlight, layer, monochromatic_srf
+from _common import backlight, layer, lens_sensor
 from waveplates import plate_thickness_um
 
 VARIANTS = ("scalar_spectral_polarized",)
@@ -82,25 +82,12 @@ def scene(width: int = 360, height: int = 240, spp: int = 16, filter_bandwidth: 
     """
     if plate not in ("split", "retarder", "quartz"):
         raise ValueError(f"plate must be split, retarder or quartz, got {plate!r}")
-    film = {"type": "hdrfilm", "pixel_format": "rgb"}
-    if wavelength_nm is not None and not stokes:
-        film = {"type": "specfilm", "band": monochromatic_srf(wavelength_nm)}
-    film.update({"width": width, "height": height, "rfilter": {"type": "box"}})
-    if crop is not None:
-        film.update({"crop_offset_x": crop[0], "crop_offset_y": crop[1], "crop_width": crop[2],
-                     "crop_height": crop[3]})
-    sensor = {
-        "type": "perspective", "fov": fov_deg, "fov_axis": "x",
-        "to_world": T().look_at(origin=[0, 0, CAMERA_HEIGHT], target=[0, 0, 0], up=[0, 1, 0]),
-        "film": film, "sampler": {"type": "independent", "sample_count": spp},
-    }
-    if wavelength_nm is not None and stokes:
-        sensor["srf"] = monochromatic_srf(wavelength_nm)
     nested = {"type": "volpath", "max_depth": 8}
     d = {
         "type": "scene",
         "integrator": {"type": "stokes", "nested": nested} if stokes else nested,
-        "sensor": sensor,
+        "sensor": lens_sensor(width, height, spp, fov_deg, CAMERA_HEIGHT, wavelength_nm,
+                              single_channel=not stokes, crop=crop),
         "light": backlight(-1.0, HALF, black=True),
         # Mitsuba's polarizer transmits along -theta (see scenes/_common.py).
         "polarizer": layer(-0.5, HALF, HALF, {"type": "polarizer", "theta": -polarizer_deg}),
