@@ -15,7 +15,8 @@ that scene). Each goes to `<out>/<name>.exr` and `.png` (`render.render` or
 the first paragraph of its docstring under each. The examples of EXAMPLES (not scenes: e.g. an
 optimisation through the renderer, a plot of rendered measurements) make their own figure with
 their `gallery(out)` function. Every panel's method, samples per pixel and time go to
-`<out>/gallery.json` and are printed.
+`<out>/gallery.json` and are printed. `--noise` renders each scene's panel a second time with
+another seed (into `<out>/noise/`) and adds its noise per pixel (`noise`).
 """
 
 from __future__ import annotations
@@ -57,13 +58,14 @@ def render_settings(module, sampler: str) -> tuple[bool, str]:
     return bool(settings.get("analytic", False)), settings.get("sampler", sampler)
 
 
-def render_panel(name: str, module, out: pathlib.Path, width: int, spp: int, sampler: str) -> tuple[pathlib.Path, dict]:
+def render_panel(name: str, module, out: pathlib.Path, width: int, spp: int, sampler: str,
+                 seed: int = 0) -> tuple[pathlib.Path, dict]:
     """Renders scene `name`'s panel; returns its PNG and what it cost."""
     options = gallery_options(module, width, spp)
     analytic, sampler = render_settings(module, sampler)
     start = time.perf_counter()
     draw = render.render_analytic if analytic else render.render
-    png = draw(name, out, sampler=sampler, **options)
+    png = draw(name, out, sampler=sampler, seed=seed, **options)
     cost = {"method": "render_analytic (srgb-d65)" if analytic else f"{module.VARIANTS[0]}",
             "sampler": sampler, "spp": options["spp"], "size": [options["width"], options["height"]],
             "seconds": time.perf_counter() - start}
@@ -98,6 +100,31 @@ def contact_sheet(entries: list[tuple[str, str, pathlib.Path]], path: pathlib.Pa
     plt.close(fig)
 
 
+def linear_rgb(exr: pathlib.Path):
+    """The first three channels of a panel's EXR (linear RGB: render.py writes them first)."""
+    import mitsuba as mi
+    import numpy as np
+
+    return np.array(mi.Bitmap(str(exr)), dtype=np.float64)[..., :3]
+
+
+def noise(a, b) -> dict:
+    """Noise per pixel of a render, from two renders `a`, `b` (linear RGB) that differ only in the
+    seed, over the lit pixels (luminance above a fifth of the 99th percentile of their mean):
+    the RMS of |Y_a - Y_b| / sqrt(2) / Y (brightness) and of the difference of the
+    chromaticities r and g / sqrt(2) (colour)."""
+    import numpy as np
+
+    luminance = lambda x: x @ np.array([0.2126, 0.7152, 0.0722])  # noqa: E731
+    chromaticity = lambda x: (x / np.maximum(x.sum(-1, keepdims=True), 1e-12))[..., :2]  # noqa: E731
+    y = luminance(0.5 * (a + b))
+    lit = y > 0.2 * np.percentile(y, 99)
+    brightness = (np.abs(luminance(a) - luminance(b)) / np.sqrt(2))[lit] / y[lit]
+    colour = np.abs(chromaticity(a) - chromaticity(b))[lit] / np.sqrt(2)
+    return {"brightness": float(np.sqrt(np.mean(brightness**2))),
+            "colour": float(np.sqrt(np.mean(colour**2)))}
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--out", type=pathlib.Path, default=pathlib.Path("out/gallery"))
@@ -109,6 +136,8 @@ def main() -> None:
     p.add_argument("--only", nargs="*", default=None, help="render only these scenes")
     p.add_argument("--reuse", action="store_true",
                    help="use the PNGs already in --out where they exist (only redraw the sheet)")
+    p.add_argument("--noise", action="store_true",
+                   help="render each scene's panel again with another seed and state its noise")
     a = p.parse_args()
     entries, costs, start = [], {}, time.perf_counter()
     for name in render.scene_names():
@@ -118,6 +147,10 @@ def main() -> None:
         png = a.out / f"{name}.png"
         if not (a.reuse and png.exists()):
             png, costs[name] = render_panel(name, module, a.out, a.width, a.spp, a.sampler)
+        if a.noise:
+            render_panel(name, module, a.out / "noise", a.width, a.spp, a.sampler, seed=1)
+            costs.setdefault(name, {})["noise"] = noise(linear_rgb(a.out / f"{name}.exr"),
+                                                        linear_rgb(a.out / "noise" / f"{name}.exr"))
         caption = " ".join((module.__doc__ or "").strip().split("\n\n")[0].split())
         entries.append((name, caption, png))
     for name in EXAMPLES:
@@ -134,8 +167,11 @@ def main() -> None:
     contact_sheet(entries, a.sheet)
     total = time.perf_counter() - start
     for name, c in costs.items():
-        print(f"  {name:22s} {c['method']:28s} {c.get('sampler', ''):12s} {c.get('spp', ''):>5} spp "
-              f"{c['seconds']:7.1f} s")
+        said = (f"  {name:22s} {c.get('method', ''):28s} {c.get('sampler', ''):12s} "
+                f"{c.get('spp', ''):>5} spp {c.get('seconds', float('nan')):7.1f} s")
+        if "noise" in c:
+            said += f"; noise: brightness {c['noise']['brightness']:.4f}, colour {c['noise']['colour']:.4f}"
+        print(said)
     (a.out / "gallery.json").write_text(json.dumps({"panels": costs, "seconds": total,
                                                      "load_average": load_average()}, indent=1))
     print(f"contact sheet {a.sheet} ({len(entries)} scenes) in {total:.0f} s")
