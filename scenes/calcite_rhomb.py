@@ -126,6 +126,6 @@ def scene(width: int = 360, height: int = 240, spp: int = 32, filter_bandwidth: 
 #: multijitter (20 % over all the lit pixels, the sheet around the block included). The
 #: `orthogonal` sampler (orthogonal arrays, Jarosz et al. 2019: every pair of sample dimensions
 #: stratified jointly, so the entry's and the exit's choices are stratified together) does with
-#: 25 spp what multijitter does with 64; at 121 spp (11^2) 3.2 % over the lit pixels,
+#: 25 spp what multijitter does with 64; at 121 spp (11^2) 3.0 % over the lit pixels,
 #: docs/scenes.md.
 GALLERY = {"sampler": "orthogonal", "spp": 121}

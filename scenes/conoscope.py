@@ -99,7 +99,7 @@ def scene(width: int = 320, height: int = 320, spp: int = 16, filter_bandwidth: 
 
 
 #: Gallery options (scenes/gallery.py): a channel render (`render_analytic`: no colour noise;
-#: 2.2 % of brightness noise per pixel at 16 spp). A 1 mm calcite plate integrated over a colour
+#: 3.2 % of brightness noise per pixel at 8 spp). A 1 mm calcite plate integrated over a colour
 #: channel off the normal is one of the plugin's costliest queries (about 0.18 ms per sample and
 #: pass on 2 loaded cores), hence 256 px and 8 spp; docs/scenes.md.
 GALLERY = {"analytic": True, "spp": 8, "width": 256, "height": 256}

@@ -66,5 +66,5 @@ def scene(width: int = 384, height: int = 128, spp: int = 16, max_thickness_um: 
 
 
 #: Gallery options (scenes/gallery.py): a channel render (`render_analytic`: no colour noise;
-#: spectral sampling at 8 spp left 3.1 % of chromaticity noise per pixel), docs/scenes.md.
+#: spectral sampling at 8 spp left a chromaticity noise of 0.031 per pixel), docs/scenes.md.
 GALLERY = {"analytic": True, "spp": 16}

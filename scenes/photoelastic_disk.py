@@ -134,5 +134,6 @@ def scene(width: int = 512, height: int = 512, spp: int = 16, filter_bandwidth: 
 
 
 #: Gallery options (scenes/gallery.py): a channel render (`render_analytic`: no colour noise;
-#: spectral sampling left 5.0 % of brightness and 2.9 % of chromaticity noise per pixel at 16 spp), docs/scenes.md.
+#: spectral sampling at 16 spp left 5.0 % of brightness noise per pixel and a chromaticity
+#: noise of 0.029), docs/scenes.md.
 GALLERY = {"analytic": True, "spp": 16}

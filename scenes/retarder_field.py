@@ -178,7 +178,7 @@ def main() -> None:
 
 
 #: Gallery options (scenes/gallery.py): a channel render (`render_analytic`: no colour noise;
-#: 2.7 % of brightness noise per pixel at 16 spp); the quartz plate integrated over a colour
+#: 4.7 % of brightness noise per pixel at 8 spp); the quartz plate integrated over a colour
 #: channel off the normal costs about 0.07 ms per sample and pass on 2 loaded cores, hence
 #: 8 spp; docs/scenes.md.
 GALLERY = {"analytic": True, "spp": 8}

@@ -130,5 +130,6 @@ def scene(width: int = 360, height: int = 240, spp: int = 32, filter_bandwidth: 
 
 
 #: Gallery options (scenes/gallery.py): a channel render (`render_analytic`: no colour noise;
-#: spectral sampling left 3.6 % of brightness and 1.1 % of chromaticity noise per pixel at 16 spp), docs/scenes.md.
+#: spectral sampling at 16 spp left 3.6 % of brightness noise per pixel and a chromaticity
+#: noise of 0.011), docs/scenes.md.
 GALLERY = {"analytic": True, "spp": 16}

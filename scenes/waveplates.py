@@ -96,6 +96,6 @@ def scene(width: int = 384, height: int = 128, spp: int = 16, filter_bandwidth: 
 
 
 #: Gallery options (scenes/gallery.py): a channel render (`render_analytic`: no colour noise;
-#: spectral sampling at 4 spp left 10 % of brightness and 3.9 % of chromaticity noise per
-#: pixel, the speckle of the old gallery), docs/scenes.md.
+#: spectral sampling at 4 spp left 10 % of brightness noise per pixel and a chromaticity noise
+#: of 0.039, the speckle of the old gallery), docs/scenes.md.
 GALLERY = {"analytic": True, "spp": 16}
