@@ -5,9 +5,10 @@
 #                 polarisers: its isochromatic fringes) by colour channels (render_analytic,
 #                 the multijitter sampler) to out/photoelastic_disk.exr and .png, and Figure 1
 #                 of the paper's supplemental to out/fig1.png and out/fig1.json
-#   make gallery  make setup, then renders every scene of scenes/ at gallery size (multijitter
-#                 sampler) into out/gallery/ and the contact sheet scenes/gallery.png (several
-#                 minutes)
+#   make gallery  make setup, then renders every scene of scenes/ at gallery size (by colour
+#                 channels where one plate is on every path; each scene's GALLERY options) into
+#                 out/gallery/ and the contact sheet scenes/gallery.png (24 min on 2 cores at load
+#                 average 10; docs/scenes.md lists each panel's samples and time)
 #   make test     builds everything (make setup), then runs every test: cargo fmt --check, cargo
 #                 clippy (warnings are errors), cargo's tests, then pytest's, then make fuzz-ci
 #   make setup    cargo build --release, the virtualenv .venv/ from requirements.txt, Debian's

@@ -193,6 +193,13 @@ def overhead_table(o: dict) -> list[str]:
             cells.append("—" if x is None else f"{x:.2f} ({within(x, row['goal'][v])})"
                          + ("" if e is None else f"; evaluated: {e:.2f}"))
         lines.append(f"| {row['kind']} | {row['what']} | " + " | ".join(cells) + " |")
+    for row in o["rows"].values():
+        if "measured" in row:  # measured apart (bench/scenes.py --pairs), with the same settings
+            r = row["measured"]
+            lines.append(f"\nThe row \"{row['what']}\" was measured on its own on {r['date']} by "
+                         f"`{r['command']}` ({r['seconds'] / 60:.1f} min; load average (1 min) "
+                         f"{fmt_load(r.get('load_average_start'))} at the start and "
+                         f"{fmt_load(r.get('load_average_end'))} at the end{busy(r)}), as above.")
     return lines
 
 

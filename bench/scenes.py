@@ -3,7 +3,7 @@
 
     .venv/bin/python bench/scenes.py [--out bench/out] [--results bench/results.json]
                                      [--scenes a,b] [--repeats N] [--quick]
-                                     [--only overhead]
+                                     [--only overhead [--pairs KEY,KEY]]
 
 Three parts, all measured here, in this process, with Mitsuba's default thread pool (every core
 of the machine; wall time of ``mi.render`` only, the scene loaded and rendered once beforehand,
@@ -71,7 +71,9 @@ except for the channel render: see (d)):
    product of the two ratios (`overhead`). The same loop times the isotropic fast path at scene
    level (``FAST_PATH_PAIRS``): the glass scenes with eta_e = 1.5 + 1e-9 (optically identical,
    anisotropic to the core) against eta_e = 1.5, in scalar_spectral_polarized.
-   ``--only overhead`` measures this part alone and merges it into the existing results.
+   ``--only overhead`` measures this part alone and merges it into the existing results;
+   ``--pairs`` with it measures only the named rows of ``OVERHEAD_PAIRS`` and merges those rows,
+   each with its own date, load and command (``measured``), keeping every other figure.
 
 3. **Shortcuts**: the core-level ratios of ``examples/bench_shortcuts.rs`` (read from
    ``bench/out/shortcuts.json``, which ``make bench-scenes`` writes first) plus the scene-level
@@ -700,7 +702,30 @@ CONFIGS = {
     "bouncing_calcite/dielectric": lambda mi: bouncing_sphere(mi, mitsuba_bsdf("dielectric", CALCITE_N_O)),
     "bouncing_calcite/birefringent": lambda mi: bouncing_sphere(
         mi, crystal(material="calcite", optic_axis=[1.0, 1.0, 1.0], optic_axis_space="world")),
+    "cellophane/birefringentstack": lambda mi: cellophane_scene("birefringentstack"),
+    "cellophane/thindielectric": lambda mi: cellophane_scene("thindielectric"),
 }
+
+
+#: The configurations (their scene part before the "/") that are whole scenes, not rooms.
+WHOLE_SCENES = ("cellophane",)
+
+
+def cellophane_scene(plugin: str) -> dict:
+    """Not a room: the gallery's cellophane scene (scenes/cellophane.py) at the overhead's size
+    (3:2), spp and independent sampler; with "birefringentstack" as it is (one rectangle, a
+    stack of 4 layers whose thicknesses and axes are textures), with "thindielectric" each strip
+    a rectangle of its own with `thindielectric` of the film's ordinary index (what one builds
+    without birefringent layers: paths meet 0 to 4 films)."""
+    if str(SCENES_DIR) not in sys.path:
+        sys.path.insert(0, str(SCENES_DIR))
+    import cellophane
+
+    d = cellophane.scene(width=OVERHEAD_SIZE, height=round(OVERHEAD_SIZE * 2 / 3), spp=OVERHEAD_SPP)
+    if plugin == "thindielectric":
+        del d["cellophane"]
+        d.update(cellophane.strips_as_shapes({"type": "thindielectric", "int_ior": cellophane.INDEX}))
+    return d
 
 
 class Pair(typing.NamedTuple):
@@ -748,6 +773,11 @@ OVERHEAD_PAIRS = {
         "isotropic", "bouncing_glass/birefringent", "bouncing_glass/dielectric", BOTH,
         "a glass sphere on the floor filling half the frame, light bouncing inside it "
         "(eta_o = eta_e = 1.5) vs `dielectric` 1.5"),
+    "anisotropic/cellophane": Pair(
+        "anisotropic", "cellophane/birefringentstack", "cellophane/thindielectric", PLATES,
+        "the cellophane scene (scenes/cellophane.py: 8 strips between crossed polarisers, one "
+        "`birefringentstack` of 4 textured layers) vs the same strips as `thindielectric` "
+        "rectangles (int_ior 1.5)"),
     "anisotropic/bouncing_calcite_sphere": Pair(
         "anisotropic", "bouncing_calcite/birefringent", "bouncing_calcite/dielectric", POLARIZED,
         "a calcite sphere on the floor filling half the frame, light bouncing inside it (optic axis "
@@ -790,7 +820,8 @@ def overhead_goal(pair: Pair, variant: str) -> str:
 def overhead_room(mi, name: str, variant: str) -> dict:
     """The room of configuration `name` for `variant`: in a variant of CHANNEL_PASS, the pass of
     its channel as ``render_analytic`` renders it (``analytic.channel_passes``)."""
-    d = room(mi, CONFIGS[name](mi))
+    objects = CONFIGS[name](mi)
+    d = objects if objects.get("type") == "scene" else room(mi, objects)
     if variant not in CHANNEL_PASS:
         return d
     from mitsuba_birefringent.analytic import CHANNELS, channel_passes
@@ -884,7 +915,7 @@ def symbolic_factor(mi, scenes: dict, repeats: int) -> dict:
     return {"scenes": out, "kernels_while_timed": kernels}
 
 
-def overhead(repeats: int) -> dict:
+def overhead(repeats: int, only: list[str] | None = None) -> dict:
     """Every pair of OVERHEAD_PAIRS and FAST_PATH_PAIRS in each of OVERHEAD_VARIANTS: every
     configuration a variant needs loaded and rendered once at the timed spp, then `repeats`
     interleaved rounds (`timed_rounds`); ratios ours / Mitsuba's of the median times. In the
@@ -894,10 +925,14 @@ def overhead(repeats: int) -> dict:
     import gc
 
     pairs = {**OVERHEAD_PAIRS, **FAST_PATH_PAIRS}
+    if only is not None:
+        pairs = {k: pairs[k] for k in only}
     out = {}
     for variant in OVERHEAD_VARIANTS:
-        mi = set_variant(variant)
         here = {k: p for k, p in pairs.items() if variant in p.variants}
+        if not here:
+            continue
+        mi = set_variant(variant)
         names = list(dict.fromkeys(n for p in here.values() for n in (p.theirs, p.ours)))
         scenes = {name: mi.load_dict(overhead_room(mi, name, variant)) for name in names}
         times, kernels = timed_rounds(mi, scenes, dict.fromkeys(names, evaluated(variant)), repeats)
@@ -936,15 +971,20 @@ def now() -> str:
     return datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
 
 
-def overhead_summary(over: dict, repeats: int, measured: dict) -> dict:
-    """results.json's "overhead": how it was measured, and per row of OVERHEAD_PAIRS its kind,
-    scene and ratio ours / Mitsuba's per variant."""
-    rows = {k: {"kind": p.kind, "plugin": p.plugin, "what": p.what, "ours": p.ours, "theirs": p.theirs,
+def overhead_rows(over: dict, keys) -> dict:
+    """Per row of OVERHEAD_PAIRS in `keys`: its kind, scene and ratio ours / Mitsuba's per
+    variant (results.json's "overhead" "rows")."""
+    return {k: {"kind": p.kind, "plugin": p.plugin, "what": p.what, "ours": p.ours, "theirs": p.theirs,
                 "ratio": {v: over[v]["ratios"][k] for v in p.variants},
                 "goal": {v: OVERHEAD_GOALS[overhead_goal(p, v)][1] for v in p.variants},
                 "ratio_vs_evaluated": {v: over[v]["ratios_vs_evaluated"][k] for v in p.variants
                                        if "ratios_vs_evaluated" in over[v]}}
-            for k, p in OVERHEAD_PAIRS.items()}
+            for k, p in OVERHEAD_PAIRS.items() if k in keys}
+
+
+def overhead_summary(over: dict, repeats: int, measured: dict) -> dict:
+    """results.json's "overhead": how it was measured, and every row (`overhead_rows`)."""
+    rows = overhead_rows(over, OVERHEAD_PAIRS)
     settings = {"size": OVERHEAD_SIZE, "spp": OVERHEAD_SPP, "repeats": repeats,
                 "integrator": "path, max_depth 8", "variants": list(OVERHEAD_VARIANTS),
                 "channel_pass": CHANNEL_PASS,
@@ -991,6 +1031,26 @@ def merge_overhead(results_path: pathlib.Path, detail_path: pathlib.Path, over: 
     return results, detail
 
 
+def merge_overhead_rows(results_path: pathlib.Path, detail_path: pathlib.Path, over: dict,
+                        keys: list[str], repeats: int, measured: dict) -> tuple[dict, dict]:
+    """`--only overhead --pairs`: the existing results with the rows `keys` replaced (or added),
+    each carrying `measured` (its own date, load and command); the table's settings must be
+    those the rows were measured with."""
+    if not results_path.exists():
+        raise SystemExit(f"{results_path}: no results to merge into; run without --only first")
+    results = json.loads(results_path.read_text())
+    settings = results["overhead"]["settings"]
+    if (settings["size"], settings["spp"], settings["repeats"]) != (OVERHEAD_SIZE, OVERHEAD_SPP, repeats):
+        raise SystemExit("--pairs: the table was measured with other settings; measure it whole")
+    rows = overhead_rows(over, keys)
+    for row in rows.values():
+        row["measured"] = measured
+    results["overhead"]["rows"].update(rows)
+    detail = json.loads(detail_path.read_text()) if detail_path.exists() else {}
+    detail.setdefault("overhead_pairs", {})[",".join(keys)] = over
+    return results, detail
+
+
 def main() -> int:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--out", type=pathlib.Path, default=ROOT / "bench" / "out")
@@ -1001,6 +1061,9 @@ def main() -> int:
     p.add_argument("--only", choices=("overhead",), default=None,
                    help="measure the overhead table alone and merge it into RESULTS (and "
                         "OUT/scenes.json), keeping the other figures")
+    p.add_argument("--pairs", default=None,
+                   help="with --only overhead: comma-separated keys of OVERHEAD_PAIRS to measure "
+                        "and merge, keeping the other rows")
     p.add_argument("--repeats", type=int, default=OVERHEAD_REPEATS)
     p.add_argument("--quick", action="store_true",
                    help="tiny budgets to check that the script runs (figures meaningless)")
@@ -1024,20 +1087,28 @@ def main() -> int:
     if a.only is None:
         modules = discover(a.scenes.split(",") if a.scenes else None)
         scenes = {name: error_vs_time(name, m, a.out) for name, m in modules.items()}
+    pairs = a.pairs.split(",") if a.pairs else None
+    if pairs is not None and (a.only != "overhead" or not set(pairs) <= set(OVERHEAD_PAIRS)):
+        p.error(f"--pairs needs --only overhead and keys of OVERHEAD_PAIRS: {', '.join(OVERHEAD_PAIRS)}")
     overhead_started, overhead_load = time.perf_counter(), load_average()
-    over = overhead(a.repeats)
-    summary = overhead_summary(over, a.repeats, {
+    over = overhead(a.repeats, pairs)
+    measured = {
         "date": now(), "cpu": machine()["cpu"], "logical_cores": machine()["logical_cores"],
         "load_average_start": overhead_load, "load_average_end": load_average(),
         "seconds": time.perf_counter() - overhead_started,
-        "command": "bench/scenes.py" + (" --only overhead" if a.only else "")})
+        "command": "bench/scenes.py" + (" --only overhead" if a.only else "")
+        + (f" --pairs {a.pairs}" if a.pairs else "")}
     detail_path = a.out / "scenes.json"
-    if a.only == "overhead":
+    if pairs is not None:
+        results, detail = merge_overhead_rows(a.results, detail_path, over, pairs, a.repeats, measured)
+    elif a.only == "overhead":
+        summary = overhead_summary(over, a.repeats, measured)
         results, detail = merge_overhead(a.results, detail_path, over, summary)
     else:
         shortcuts_path = a.shortcuts or a.out / "shortcuts.json"
         core_shortcuts = json.loads(shortcuts_path.read_text()) if shortcuts_path.exists() else None
         shortcuts, shortcut_cases = shortcut_summary(core_shortcuts, over)
+        summary = overhead_summary(over, a.repeats, measured)
         results = {
             "date": now(),
             "machine": dict(machine(), load_average_start=load_before, load_average_end=load_average()),

@@ -76,16 +76,17 @@ def monochromatic_srf(wavelength_nm: float, width_nm: float = 0.01) -> dict:
     }
 
 
-def ortho_sensor(width: int, height: int, spp: int, half_x: float, half_y: float,
-                 wavelength_nm: float | None = None, z: float = 10.0,
-                 single_channel: bool = True, crop: tuple[int, int, int, int] | None = None) -> dict:
-    """Orthographic camera at height z looking down -z, seeing [-half_x, half_x] x [-half_y,
-    half_y]. `wavelength_nm` makes it monochromatic: with `single_channel` a one-channel
-    `specfilm` whose band is `monochromatic_srf` (the radiance in that band), otherwise an RGB
-    `hdrfilm` on a sensor with that response (the layout the `stokes` integrator needs; in Mitsuba
-    3.9.1 `stokes` with a `specfilm` crashes, and an `hdrfilm`'s own RGB channels come out near 0
-    with a narrow sensor response, while the `stokes` S0..S3 channels are right). `crop` =
-    (offset_x, offset_y, width, height) renders only that window of the width x height film."""
+def camera(kind: str, to_world, width: int, height: int, spp: int,
+           wavelength_nm: float | None = None, single_channel: bool = True,
+           crop: tuple[int, int, int, int] | None = None, **options) -> dict:
+    """A sensor of type `kind` (with `options`, e.g. a perspective camera's `fov`), a box-filtered
+    film of width x height pixels and the independent sampler. `wavelength_nm` makes it
+    monochromatic: with `single_channel` a one-channel `specfilm` whose band is
+    `monochromatic_srf` (the radiance in that band), otherwise an RGB `hdrfilm` on a sensor with
+    that response (the layout the `stokes` integrator needs; in Mitsuba 3.9.1 `stokes` with a
+    `specfilm` crashes, and an `hdrfilm`'s own RGB channels come out near 0 with a narrow sensor
+    response, while the `stokes` S0..S3 channels are right). `crop` = (offset_x, offset_y,
+    width, height) renders only that window of the film."""
     if wavelength_nm is not None and single_channel:
         film = {"type": "specfilm", "band": monochromatic_srf(wavelength_nm)}
     else:
@@ -94,27 +95,47 @@ def ortho_sensor(width: int, height: int, spp: int, half_x: float, half_y: float
     if crop is not None:
         film.update({"crop_offset_x": crop[0], "crop_offset_y": crop[1], "crop_width": crop[2],
                      "crop_height": crop[3]})
-    sensor = {
-        "type": "orthographic",
-        # Mitsuba's orthographic camera sees [-1, 1] x [-1/aspect, 1/aspect] in its own frame
-        # (aspect = width / height): scale y by the aspect to see +-half_y.
-        "to_world": T().look_at(origin=[0, 0, z], target=[0, 0, 0], up=[0, 1, 0])
-        @ T().scale([half_x, half_y * width / height, 1.0]),
-        "film": film,
-        "sampler": {"type": "independent", "sample_count": spp},
-    }
+    sensor = {"type": kind, **options, "to_world": to_world, "film": film,
+              "sampler": {"type": "independent", "sample_count": spp}}
     if wavelength_nm is not None and not single_channel:
         sensor["srf"] = monochromatic_srf(wavelength_nm)
     return sensor
 
 
-def backlight(z: float, half: float, scale: float = 1.0) -> dict:
-    """A large D65 area light facing +z (white light from behind the optical train)."""
-    return {
+def ortho_sensor(width: int, height: int, spp: int, half_x: float, half_y: float,
+                 wavelength_nm: float | None = None, z: float = 10.0,
+                 single_channel: bool = True, crop: tuple[int, int, int, int] | None = None) -> dict:
+    """Orthographic camera at height z looking down -z, seeing [-half_x, half_x] x [-half_y,
+    half_y] (film and monochromatic options: `camera`)."""
+    # Mitsuba's orthographic camera sees [-1, 1] x [-1/aspect, 1/aspect] in its own frame
+    # (aspect = width / height): scale y by the aspect to see +-half_y.
+    to_world = (T().look_at(origin=[0, 0, z], target=[0, 0, 0], up=[0, 1, 0])
+                @ T().scale([half_x, half_y * width / height, 1.0]))
+    return camera("orthographic", to_world, width, height, spp, wavelength_nm, single_channel, crop)
+
+
+def lens_sensor(width: int, height: int, spp: int, fov_deg: float, z: float,
+                wavelength_nm: float | None = None, single_channel: bool = True,
+                crop: tuple[int, int, int, int] | None = None) -> dict:
+    """Perspective camera at height z looking down -z (image up = +y) with a lens of `fov_deg`
+    across the image's width (film and monochromatic options: `camera`)."""
+    to_world = T().look_at(origin=[0, 0, z], target=[0, 0, 0], up=[0, 1, 0])
+    return camera("perspective", to_world, width, height, spp, wavelength_nm, single_channel, crop,
+                  fov=fov_deg, fov_axis="x")
+
+
+def backlight(z: float, half: float, scale: float = 1.0, black: bool = False) -> dict:
+    """A large D65 area light facing +z (white light from behind the optical train). Mitsuba
+    gives a shape without a BSDF a grey diffuse one (reflectance 0.5), which sends light that the
+    optics reflect back down into the view again; `black` makes the light box reflect nothing."""
+    light = {
         "type": "rectangle",
         "to_world": T().translate([0, 0, z]).scale([half, half, 1.0]),
         "emitter": {"type": "area", "radiance": {"type": "d65", "scale": scale}},
     }
+    if black:
+        light["bsdf"] = {"type": "diffuse", "reflectance": 0.0}
+    return light
 
 
 def pixel_centres(n: int, half: float) -> np.ndarray:

@@ -65,6 +65,6 @@ def scene(width: int = 384, height: int = 128, spp: int = 16, max_thickness_um: 
     }
 
 
-#: Gallery options (scenes/gallery.py): the band-filtered thin wedge is one of the plugin's
-#: costliest queries (~0.3 ms per sample on 2 cores here); 8 samples keep the gallery quick.
-GALLERY = {"spp": 8}
+#: Gallery options (scenes/gallery.py): a channel render (`render_analytic`: no colour noise;
+#: spectral sampling at 8 spp left a chromaticity noise of 0.031 per pixel), docs/scenes.md.
+GALLERY = {"analytic": True, "spp": 16}

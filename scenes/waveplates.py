@@ -95,6 +95,7 @@ def scene(width: int = 384, height: int = 128, spp: int = 16, filter_bandwidth: 
     }
 
 
-#: Gallery options (scenes/gallery.py): each column is uniform, so few samples suffice, and the
-#: band-filtered thin plate is the costliest query of the plugin (~0.5 ms per sample here).
-GALLERY = {"spp": 4}
+#: Gallery options (scenes/gallery.py): a channel render (`render_analytic`: no colour noise;
+#: spectral sampling at 4 spp left 10 % of brightness noise per pixel and a chromaticity noise
+#: of 0.039, the speckle of the old gallery), docs/scenes.md.
+GALLERY = {"analytic": True, "spp": 16}

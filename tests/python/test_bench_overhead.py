@@ -4,8 +4,9 @@ transforms, polarisers) and differ only in the BSDF under test, which is the plu
 names, of the kind it is labelled with (isotropic or anisotropic as the plugin itself reports
 it), against the Mitsuba plugin a user would use instead; both rooms load in each variant
 the pair is timed in; the channel-pass rooms are the pass render_analytic renders; and each row
-is judged by the goal of its kind. Only scene descriptions are built and loaded here; nothing is
-rendered.
+is judged by the goal of its kind. The cellophane row is a whole scene, not a room: its two
+scenes share everything but the film (one stack, or a `thindielectric` rectangle per strip).
+Only scene descriptions are built and loaded here; nothing is rendered.
 """
 
 import importlib.util
@@ -62,7 +63,8 @@ def split(scene: dict) -> tuple[dict, list[dict]]:
     return walk(plain(scene)), found
 
 
-CASES = [(key, variant) for key, p in PAIRS.items() for variant in p.variants]
+WHOLE = {k for k, p in PAIRS.items() if p.ours.split("/")[0] in B.WHOLE_SCENES}
+CASES = [(key, variant) for key, p in PAIRS.items() if key not in WHOLE for variant in p.variants]
 
 
 @pytest.mark.parametrize("key,variant", CASES, ids=[f"{k}-{v}" for k, v in CASES])
@@ -88,7 +90,8 @@ def test_pair_differs_only_in_the_bsdf(key, variant):
     mi.load_dict(theirs_scene)
 
 
-@pytest.mark.parametrize("key", [k for k, p in PAIRS.items() if "crossed polarisers" in p.what])
+@pytest.mark.parametrize("key", [k for k, p in PAIRS.items() if "crossed polarisers" in p.what
+                                 and k not in WHOLE])
 def test_plates_stand_between_crossed_polarizers(key):
     mi = B.set_variant("scalar_spectral_polarized")
     rest, plates = split(B.room(mi, B.CONFIGS[PAIRS[key].ours](mi)))
@@ -166,3 +169,26 @@ def test_llvm_and_bouncing_rows_are_timed():
         assert set(B.CHANNEL_PASS) <= set(B.OVERHEAD_PAIRS[f"anisotropic/quartz_plates_{d}um"].variants)
     calcite = B.OVERHEAD_PAIRS["anisotropic/bouncing_calcite_sphere"]
     assert set(calcite.variants) == {"scalar_spectral_polarized", "llvm_ad_spectral_polarized"}
+
+
+@pytest.mark.parametrize("variant", B.OVERHEAD_PAIRS["anisotropic/cellophane"].variants)
+def test_cellophane_pair_differs_only_in_the_film(variant):
+    """Ours: the scene with its one stack; theirs: the same scene with one `thindielectric`
+    rectangle per strip of the film's index instead; everything else equal."""
+    p = B.OVERHEAD_PAIRS["anisotropic/cellophane"]
+    assert WHOLE == {"anisotropic/cellophane"}
+    mi = B.set_variant(variant)
+    ours = plain(B.overhead_room(mi, p.ours, variant))
+    theirs = plain(B.overhead_room(mi, p.theirs, variant))
+    import cellophane  # scenes/ is on the path once a cellophane configuration was built
+
+    stack = ours.pop("cellophane")["bsdf"]
+    strips = {k: theirs.pop(k) for k in list(theirs) if k.startswith("strip_")}
+    assert ours == theirs
+    assert stack["type"] == p.plugin == "birefringentstack"
+    assert len(strips) == len(cellophane.STRIPS)
+    assert {s["bsdf"]["type"] for s in strips.values()} == {"thindielectric"}
+    assert {s["bsdf"]["int_ior"] for s in strips.values()} == {cellophane.INDEX}
+    assert bool(mi.load_dict(B.overhead_room(mi, p.ours, variant)["cellophane"]["bsdf"]).flags()
+                & mi.BSDFFlags.Anisotropic)
+    mi.load_dict(B.overhead_room(mi, p.theirs, variant))

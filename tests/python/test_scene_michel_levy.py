@@ -37,6 +37,7 @@ import mitsuba as mi
 import numpy as np
 
 import mitsuba_birefringent  # noqa: F401
+import scene_optics
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "scenes"))
 import michel_levy  # noqa: E402
@@ -70,19 +71,7 @@ def airy_t(n, d_nm, lam_nm):
 def colour_weights(lam):
     """Per wavelength of the grid `lam`: linear sRGB of the film times the d65 emitter's
     radiance times the grid step (so that sum(weights * T) is the pixel value)."""
-    d65 = mi.load_dict({"type": "d65"})
-    si = mi.SurfaceInteraction3f()
-    out = np.zeros((len(lam), 3))
-    for k in range(0, len(lam), 4):
-        ls = lam[k:k + 4]
-        si.wavelengths = mi.UnpolarizedSpectrum(*ls)
-        radiance = np.array(d65.eval(si))
-        for j in range(4):
-            unit = [0.0] * 4
-            unit[j] = 1.0
-            rgb = np.array(mi.spectrum_to_srgb(mi.UnpolarizedSpectrum(*unit), mi.UnpolarizedSpectrum(*ls)))
-            out[k + j] = 4 * rgb * radiance[j] * STEP  # spectrum_to_srgb averages over the 4
-    return out
+    return scene_optics.colour_weights(lam, STEP)
 
 
 def band_convolved(weights):

@@ -22,7 +22,7 @@ sys.path.insert(0, str(SCENES))
 
 # name: (width, height) of the XML's aspect; spp
 CASES = {"photoelastic_disk": (32, 32), "calcite_rhomb": (36, 24), "waveplates": (48, 16),
-         "train_window": (36, 24)}
+         "train_window": (36, 24), "conoscope": (24, 24)}
 
 
 @pytest.mark.parametrize("name", sorted(CASES))
