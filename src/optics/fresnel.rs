@@ -18,7 +18,7 @@
 use crate::cmath::singular;
 use crate::error::Result;
 use crate::real::complex::{self as cx, Cx};
-use crate::real::{Mask, Real};
+use crate::real::{all_finite, Mask, Real};
 use num_complex::Complex64 as C64;
 
 /// Amplitudes `[s, p]` of one isotropic/isotropic interface, both directions of incidence.
@@ -78,10 +78,11 @@ impl<T: Real> Fresnel<T> {
             r_below: [(w2 - w1) * is, (w2 * e1 - w1 * e2) * ip],
             t_below: [w2 * is * two, two_eta * w2 * ip],
         };
-        let finite = [f.r_above, f.t_above, f.r_below, f.t_below]
-            .iter()
-            .flatten()
-            .fold(T::Mask::cst(true), |m, z| m & z.re.finite() & z.im.finite());
+        let finite = all_finite(
+            [f.r_above, f.t_above, f.r_below, f.t_below]
+                .iter()
+                .flatten(),
+        );
         (!finite).fail(singular)?;
         Ok(f)
     }

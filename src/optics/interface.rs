@@ -17,7 +17,7 @@ use crate::optics::fresnel::Fresnel;
 use crate::optics::medium::Uniaxial;
 use crate::optics::modes::{modes, Mode, ModeKind, ModeSet};
 use crate::real::complex::{self as cx, Cx};
-use crate::real::{Mask, Real};
+use crate::real::{all_finite, Mask, Real};
 use nalgebra::{Matrix2, Matrix4};
 
 /// The solved interface for one incidence parameter.
@@ -187,9 +187,7 @@ fn from_modes_s<T: Real>(upper: &ModeSet<T>, lower: &ModeSet<T>) -> Result<Matri
     } else {
         cmath::eliminate4(&lhs, &[rhs])?[0]
     };
-    let finite = s
-        .iter()
-        .fold(T::Mask::cst(true), |m, z| m & z.re.finite() & z.im.finite());
+    let finite = all_finite(s.iter());
     (!finite).fail(singular)?;
     Ok(s)
 }
@@ -217,11 +215,7 @@ fn place<T: Real>(
     r: &admittance::Solution<Cx<T>>,
     iso_above: bool,
 ) -> Result<()> {
-    let finite =
-        r.x.iter()
-            .chain(&r.y)
-            .flatten()
-            .fold(T::Mask::cst(true), |m, z| m & z.re.finite() & z.im.finite());
+    let finite = all_finite(r.x.iter().chain(&r.y).flatten());
     (!finite).fail(singular)?;
     let (first, second, shift) = if iso_above {
         (&r.x, &r.y, 0)

@@ -14,6 +14,7 @@ pub mod complex;
 pub mod select;
 
 use crate::error::{Error, Result};
+use num_complex::Complex;
 use num_traits::{Num, NumAssign};
 use std::fmt::Debug;
 use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
@@ -40,6 +41,10 @@ pub trait Real:
 {
     /// The result of a comparison.
     type Mask: Mask;
+
+    /// True for a recorded number: its program checks its outputs' finiteness once, at the end
+    /// (a non-finite intermediate reaches them), so [`all_finite`] records nothing.
+    const RECORDED: bool = false;
 
     /// The constant `x`.
     fn cst(x: f64) -> Self;
@@ -98,6 +103,18 @@ pub trait Real:
     fn hypot(self, other: Self) -> Self {
         (self * self + other * other).sqrt()
     }
+}
+
+/// Where every complex number of `values` is finite: the check of a result that is an error if
+/// it is not (a singular system). A recorded program checks its outputs instead ([`Real::RECORDED`]).
+pub fn all_finite<'a, T: Real>(values: impl IntoIterator<Item = &'a Complex<T>>) -> T::Mask {
+    let yes = T::Mask::cst(true);
+    if T::RECORDED {
+        return yes;
+    }
+    values
+        .into_iter()
+        .fold(yes, |m, z| m & z.re.finite() & z.im.finite())
 }
 
 /// The outcome of a comparison per lane: `bool`, or a recorded mask.

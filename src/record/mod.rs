@@ -301,6 +301,7 @@ impl Select<Flag> for Var {
 
 impl Real for Var {
     type Mask = Flag;
+    const RECORDED: bool = true;
     fn cst(x: f64) -> Self {
         Var(with_tape(|t| t.push(Op::Const, 0, 0, 0, x)))
     }
