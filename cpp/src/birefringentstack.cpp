@@ -171,6 +171,8 @@ private:
         for (size_t k = 0; k < m_sources.size(); ++k)
             m_material_index[k] = (uint32_t) k;
         m_band = bfr::band_spectrum(m_filter_bandwidth);
+        shim::require_kernel_path<Float, Spectrum>(is_spectral_v<Spectrum> && m_filter_bandwidth == 0.0,
+                                                   ClassName);
         m_spectrum = shim::thin_spectrum<Spectrum>(m_filter_bandwidth, m_channel, ClassName);
         m_null = m_exit_ior == m_ext_ior && !m_absorbing_exit;
         shim::thin_flags(isotropic, m_null, m_absorbing_exit, m_exit_ior != m_ext_ior, m_types,

@@ -45,6 +45,9 @@ constexpr size_t MaxInputs = 16;
 /// core needs the lanes' values, which a symbolic variable does not have.
 template <typename Float>
 void require_evaluated_mode(const char *ClassName, const char *recorded_where) {
+    if constexpr (dr::is_cuda_v<Float>)
+        Throw("a query that calls the core on the host cannot run in a CUDA variant (it runs "
+              "inside the kernel only for %s)", recorded_where);
     if constexpr (dr::is_jit_v<Float>) {
         if (jit_flag(JitFlag::SymbolicScope))
             Throw("this query of the BSDF computes its lobes outside Dr.Jit (it runs inside "

@@ -20,10 +20,13 @@
 NAMESPACE_BEGIN(mitsuba)
 NAMESPACE_BEGIN(shim)
 
-/// The variants the plugins work in, comma-separated.
+/// The variants the plugins work in, comma-separated. In the CUDA variants what runs is the
+/// core's recorded programs (replay.h): a plate or a stack only at exact wavelengths (the
+/// spectral variants, filter_bandwidth 0), refused at load otherwise (require_kernel_path).
 constexpr const char *SupportedVariants =
     "scalar_rgb, scalar_spectral, scalar_spectral_polarized, llvm_ad_rgb, llvm_ad_mono, "
-    "llvm_ad_mono_polarized, llvm_ad_spectral, llvm_ad_spectral_polarized";
+    "llvm_ad_mono_polarized, llvm_ad_spectral, llvm_ad_spectral_polarized, cuda_ad_rgb, "
+    "cuda_ad_mono, cuda_ad_mono_polarized, cuda_ad_spectral, cuda_ad_spectral_polarized";
 
 /// Registers `Plugin<Float, Spectrum>` as `name` in `variant`.
 template <template <typename, typename> class Plugin, typename Float, typename Spectrum>
@@ -33,39 +36,42 @@ void register_variant(PluginManager *pm, const char *name, const char *variant) 
         nullptr, nullptr);
 }
 
-/// Registers `name` in a CUDA variant with a constructor that refuses it with a clear message:
-/// the core runs on the CPU, so a CUDA variant would need a device-host round trip per query.
-inline void register_refusal(PluginManager *pm, const char *name, const char *variant) {
-    pm->register_plugin(name, variant, ObjectType::BSDF,
-        [](void *payload, const Properties &p) -> ref<Object> {
-            std::string v = (const char *) payload;
-            throw std::runtime_error(
-                std::string(p.plugin_name()) + ": variant \"" + v + "\" is not supported (the "
-                "birefringent core computes on the CPU); use \"llvm" + v.substr(4) + "\", or any of " +
-                SupportedVariants);
-        },
-        nullptr, (void *) variant);
+/// The plugin in the JIT variants of `Backend`.
+template <template <typename, typename> class Plugin, JitBackend Backend>
+void register_jit(PluginManager *pm, const char *name, const char *prefix) {
+    using F = dr::DiffArray<Backend, float>;
+    std::string p(prefix);
+    register_variant<Plugin, F, Color<F, 3>>(pm, name, (p + "rgb").c_str());
+    register_variant<Plugin, F, Color<F, 1>>(pm, name, (p + "mono").c_str());
+    register_variant<Plugin, F, MuellerMatrix<Color<F, 1>>>(pm, name, (p + "mono_polarized").c_str());
+    register_variant<Plugin, F, Spectrum<F, 4>>(pm, name, (p + "spectral").c_str());
+    register_variant<Plugin, F, MuellerMatrix<Spectrum<F, 4>>>(pm, name,
+                                                             (p + "spectral_polarized").c_str());
 }
 
-/// The plugin in every supported variant; the CUDA ones get a constructor with a clear error.
+/// The plugin in every supported variant.
 template <template <typename, typename> class Plugin> void register_plugin(const char *name) {
     PluginManager *pm = PluginManager::instance();
     register_variant<Plugin, float, Color<float, 3>>(pm, name, "scalar_rgb");
     register_variant<Plugin, float, Spectrum<float, 4>>(pm, name, "scalar_spectral");
     register_variant<Plugin, float, MuellerMatrix<Spectrum<float, 4>>>(pm, name,
                                                                        "scalar_spectral_polarized");
-    using FloatL = dr::DiffArray<JitBackend::LLVM, float>;
-    register_variant<Plugin, FloatL, Color<FloatL, 3>>(pm, name, "llvm_ad_rgb");
-    register_variant<Plugin, FloatL, Color<FloatL, 1>>(pm, name, "llvm_ad_mono");
-    register_variant<Plugin, FloatL, MuellerMatrix<Color<FloatL, 1>>>(pm, name,
-                                                                     "llvm_ad_mono_polarized");
-    register_variant<Plugin, FloatL, Spectrum<FloatL, 4>>(pm, name, "llvm_ad_spectral");
-    register_variant<Plugin, FloatL, MuellerMatrix<Spectrum<FloatL, 4>>>(pm, name,
-                                                                        "llvm_ad_spectral_polarized");
-    static const char *refused[] = { "cuda_ad_rgb", "cuda_ad_mono", "cuda_ad_mono_polarized",
-                                     "cuda_ad_spectral", "cuda_ad_spectral_polarized" };
-    for (const char *v : refused)
-        register_refusal(pm, name, v);
+    register_jit<Plugin, JitBackend::LLVM>(pm, name, "llvm_ad_");
+    register_jit<Plugin, JitBackend::CUDA>(pm, name, "cuda_ad_");
+}
+
+/// Refuses, at load in a CUDA variant, a plugin whose queries would call the core on the host:
+/// a CUDA kernel's lanes live on the device, so only the recorded programs run there
+/// (`recorded`: this plugin's queries are the exact element at each sampled wavelength).
+template <typename Float, typename Spectrum>
+void require_kernel_path(bool recorded, const char *ClassName) {
+    if constexpr (dr::is_cuda_v<Float>) {
+        if (!recorded)
+            Throw("in the CUDA variants a plate or stack runs inside the kernel at exact "
+                  "wavelengths only: use cuda_ad_spectral or cuda_ad_spectral_polarized with "
+                  "filter_bandwidth 0 (the closed-form integrals over a band or colour channels "
+                  "run on the CPU: use the llvm_ad variant for them)");
+    }
 }
 
 /// Host columns (indices into HostInputs) of what every query of the plugins reads: the active

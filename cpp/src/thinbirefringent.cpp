@@ -258,6 +258,8 @@ private:
         auto [material, axis] = m_diff.updated();
         m_material = shim::make_material(material, ClassName);
         m_band = bfr::band_spectrum(m_filter_bandwidth);
+        shim::require_kernel_path<Float, Spectrum>(is_spectral_v<Spectrum> && m_filter_bandwidth == 0.0,
+                                                   ClassName);
         m_spectrum = shim::thin_spectrum<Spectrum>(m_filter_bandwidth, m_channel, ClassName);
         m_null = m_exit_ior == m_ext_ior && !m_absorbing_exit;
         bool isotropic = m_material->is_isotropic(0) && !m_birefringence;
