@@ -270,7 +270,7 @@ fn extraordinary_q_w<T: Real>(medium: &Uniaxial<T>, beta: Cx<T>) -> (Cx<T>, Cx<T
         let c = |x: T| cx::real(x);
         return disc.ge(T::zero()).when(
             || {
-                let w = disc.sqrt();
+                let w = disc.safe_sqrt();
                 let inv_a = Scalar::inverse(a);
                 let w = (w * inv_a).lt(T::zero()).when(|| -w, || w);
                 (c((w - b) * inv_a), c((-w - b) * inv_a), c(w))
