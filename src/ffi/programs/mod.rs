@@ -4,8 +4,10 @@
 //! Dr.Jit's derivatives). The inputs and outputs of each program are the bridge's enums
 //! (`PlateInput`, `SampleOutput`): the one contract with the shim. One module per plugin.
 
+mod crystal;
 mod plate;
 
+pub use crystal::record_crystal;
 pub use plate::record_plate;
 
 use super::bridge::{Instr, Op as BridgeOp, SampleOutput, Transport};
