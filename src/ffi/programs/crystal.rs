@@ -47,8 +47,8 @@ pub fn record_crystal(materials: &Materials, recipe: &CrystalRecipe) -> Result<B
         let indices = (CrystalInput::EtaO, CrystalInput::EtaE);
         let kappas = (CrystalInput::KappaO, CrystalInput::KappaE);
         let material = material.lifted(
-            |x, n| given(of(x, indices), n, recipe.indices_are_inputs),
-            |x, kappa| given(of(x, kappas), kappa, recipe.kappas_are_inputs),
+            |e, n| given(of(e, indices), n, recipe.indices_are_inputs),
+            |e, kappa| given(of(e, kappas), kappa, recipe.kappas_are_inputs),
         );
         let a = recipe.optic_axis;
         let axis = Vector3::new(
@@ -57,12 +57,14 @@ pub fn record_crystal(materials: &Materials, recipe: &CrystalRecipe) -> Result<B
             given(CrystalInput::AxisZ, a[2], recipe.axis_is_input),
         );
         let norm = axis.dot(&axis).sqrt();
-        (!norm.finite() | norm.le(Var::cst(1e-300)))
-            .fail(|| Error::new("optic_axis", "must be a finite non-zero vector"))?;
+        let invalid = !norm.finite() | norm.le(Var::cst(1e-300));
+        invalid.fail(|| Error::new("optic_axis", "must be a finite non-zero vector"))?;
+        // The failing lanes compute with the normal instead (finite numbers).
+        let (zero, one) = (Var::cst(0.0), Var::cst(1.0));
         let q = ExactCrystal {
             material,
             ext: Var::cst(ext),
-            axis,
+            axis: invalid.when(|| Vector3::new(zero, zero, one), || axis),
             output: if recipe.intensity_only {
                 Intensity::Intensity
             } else {
