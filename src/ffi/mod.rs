@@ -25,7 +25,7 @@ mod tangents;
 
 pub use batch::{sample_crystal, sample_crystal_tangents, sample_plate, sample_plate_tangents};
 pub use materials::{new_materials, Materials};
-pub use programs::{record_plate, record_stack, Program};
+pub use programs::{record_crystal, record_plate, record_stack, Program};
 pub use spectrum::{
     band_spectrum, channels_to_linear_srgb, colour_channel_spectrum, colour_channel_wavelength,
     default_channel, exact_spectrum, srgb_spectrum, PlateSpectrum,
@@ -460,6 +460,57 @@ pub mod bridge {
         /// Records the sample of a stack over `recipe.channels` exact wavelengths; outputs as
         /// `record_plate`'s (`SampleOutput`).
         fn record_stack(materials: &Materials, recipe: &StackRecipe) -> Result<Box<Program>>;
+    }
+
+    /// The inputs of a crystal surface's program, by index. The path's values are always
+    /// read; the material's and the axis only where the recipe makes them inputs (otherwise
+    /// the recipe's values are constants of the program).
+    #[repr(u32)]
+    #[derive(Debug)]
+    enum CrystalInput {
+        /// Mitsuba's si.wi (local frame; z < 0 inside the crystal).
+        WiX = 0,
+        WiY = 1,
+        WiZ = 2,
+        /// The lobe-choosing uniform number.
+        Sample = 3,
+        /// optic_axis (where `axis_is_input`; any non-zero length).
+        AxisX = 4,
+        AxisY = 5,
+        AxisZ = 6,
+        /// Re eta_o, Re eta_e of constant indices (where `indices_are_inputs`).
+        EtaO = 7,
+        EtaE = 8,
+        /// kappa_o, kappa_e (where `kappas_are_inputs`).
+        KappaO = 9,
+        KappaE = 10,
+        /// The first of `channels` wavelengths (nm).
+        Wavelength0 = 11,
+    }
+
+    /// What a crystal surface's program is recorded for: the query's settings and the plugin's
+    /// parameters (which of them are inputs, the others' values as constants). The outputs
+    /// are `SampleOutput`'s; the slots are the crystal's (0 reflection, 1 and 2 the o and e
+    /// refractions from outside, 3-5 and 6-8 the lobes of light arriving as the o- and the
+    /// e-ray from inside).
+    #[derive(Debug)]
+    struct CrystalRecipe {
+        material: u32,
+        transport: Transport,
+        components: u32,
+        channels: u32,
+        intensity_only: bool,
+        ext_ior: f64,
+        optic_axis: [f64; 3],
+        axis_is_input: bool,
+        indices_are_inputs: bool,
+        kappas_are_inputs: bool,
+    }
+
+    extern "Rust" {
+        /// Records the sample of a crystal surface over `recipe.channels` exact wavelengths
+        /// (one in the RGB and mono variants: the channel's mean, `colour_channel_wavelength`).
+        fn record_crystal(materials: &Materials, recipe: &CrystalRecipe) -> Result<Box<Program>>;
     }
 
     extern "Rust" {

@@ -110,6 +110,34 @@ impl<T: Real> Material<T> {
 }
 
 impl Material {
+    /// The material over the reals `T`: each of its real numbers given by `re(extraordinary,
+    /// n)` (the real part of a constant index) or `im(extraordinary, κ)` (an extinction
+    /// coefficient), e.g. a recorded program's inputs or constants.
+    pub fn lifted<T: Real>(
+        &self,
+        re: impl Fn(bool, f64) -> T,
+        im: impl Fn(bool, f64) -> T,
+    ) -> Material<T> {
+        let lift = |index: &Index, extraordinary: bool| match *index {
+            Index::Constant(n) => {
+                Index::Constant(Cx::new(re(extraordinary, n.re), im(extraordinary, n.im)))
+            }
+            Index::Crystal {
+                crystal,
+                extraordinary,
+                kappa,
+            } => Index::Crystal {
+                crystal,
+                extraordinary,
+                kappa: im(extraordinary, kappa),
+            },
+        };
+        Material {
+            eta_o: lift(&self.eta_o, false),
+            eta_e: lift(&self.eta_e, true),
+        }
+    }
+
     /// Constant indices (validated).
     pub fn constant(eta_o: C64, eta_e: C64) -> Result<Self> {
         Ok(Material {

@@ -4,7 +4,9 @@
 //! [`crate::optics::uniaxial_fresnel`] and the fields ([`crate::optics::fields`]) of only the waves
 //! the event involves (the crystal's two down-going waves, and the incident one from inside),
 //! in real arithmetic unless one of them or the exterior wave is evanescent. `scatter` is the
-//! reference it is tested against (`tests/crystal_fast_path.rs`).
+//! reference it is tested against (`tests/crystal_fast_path.rs`). Written over the reals of
+//! [`crate::real`] ([`clear_event`]): a lobe that carries power in some lanes only comes with
+//! the mask of those lanes.
 //!
 //! Every wave that carries power in a lossless medium has a real field, and its Stokes frame
 //! ([`crate::optics::lobes`]) has `x` along that field made perpendicular to the ray, so its
@@ -12,8 +14,7 @@
 //! row of amplitudes (outgoing) or column (incoming) in the first row or column, the rest 0.
 //! Ray directions are the Poynting vectors' (eq. S12), ray indices `k·ŝ` (eq. S14).
 
-use crate::cmath::singular;
-use crate::cmath::Scalar;
+use crate::cmath::{singular, Scalar};
 use crate::error::{Error, Result};
 use crate::optics::fields::{Fields, Wave};
 use crate::optics::frame::PlaneFrame;
@@ -22,8 +23,9 @@ use crate::optics::modes::{uniaxial_normals, ModeKind};
 use crate::optics::mueller;
 use crate::optics::surface::{Incident, Surface};
 use crate::optics::uniaxial_fresnel::{Psi, UniaxialFresnel};
+use crate::real::complex::{self as cx, Cx};
+use crate::real::{Mask, Real};
 use nalgebra::{Matrix2, Vector3};
-use num_complex::Complex64 as C64;
 
 /// True if [`scatter_clear`] serves `surface`: a lossless birefringent crystal under a lossless
 /// exterior (an isotropic one has the closed form of [`crate::render::isotropic`]).
@@ -32,15 +34,15 @@ pub fn applies(surface: &Surface) -> bool {
     x.is_lossless() && x.is_isotropic() && c.is_lossless() && !c.is_isotropic()
 }
 
-/// The incident wave of an event (the fields of [`Event`] that describe it).
+/// The incident wave of an event (the fields of [`Event`] that describe it), over the reals `T`.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Arrival {
+pub struct Arrival<T: Real = f64> {
     /// Unit propagation direction (ray direction), local frame.
-    pub direction: Vector3<f64>,
+    pub direction: Vector3<T>,
     /// `x` axis of its Stokes frame.
-    pub stokes_x: Vector3<f64>,
+    pub stokes_x: Vector3<T>,
     /// Its ray index (eq. S14).
-    pub ray_index: f64,
+    pub ray_index: T,
 }
 
 /// [`crate::optics::lobes::scatter`] for a surface where [`applies`] holds: the lobes of light
@@ -77,23 +79,46 @@ pub fn each_clear_lobe(
     incident: Incident,
     mut sink: impl FnMut(&Arrival, bool, &Lobe),
 ) -> Result<Arrival> {
-    let (frame, beta) = incidence(surface, towards_light, incident)?;
+    clear_event(surface, towards_light, incident, true, |a, r, l, _| {
+        sink(a, r, l)
+    })
+}
+
+/// [`each_clear_lobe`] over the reals `T`: `sink(arrival, reflected, lobe, carries)` for each
+/// outgoing lobe that carries power in some lanes (`carries`: in which; on `f64` only those that
+/// do, with `true`). The lanes of `live` fail where the event cannot be computed (a grazing
+/// incident wave, a singular boundary system); the others, whose results a recorded program
+/// discards, compute finite numbers.
+pub fn clear_event<T: Real>(
+    surface: &Surface<T>,
+    towards_light: Vector3<T>,
+    incident: Incident,
+    live: T::Mask,
+    mut sink: impl FnMut(&Arrival<T>, bool, &Lobe<T>, T::Mask),
+) -> Result<Arrival<T>> {
+    let (frame, beta) = incidence(surface, towards_light, incident, live)?;
     let beta = beta.re;
     let crystal = surface.crystal_in(&frame);
     let eta = surface.exterior.eta_o.re;
     let w_squared = (eta - beta) * (eta + beta);
-    let (q, w_e) = uniaxial_normals(&crystal, C64::new(beta, 0.0));
+    let (q, w_e) = uniaxial_normals(&crystal, cx::real(beta));
     let at = At {
         frame: &frame,
         beta,
         eta,
         towards_light,
         incident,
+        live,
     };
     let sink = &mut sink;
-    // The e-wave's exact flux when it propagates (as `modes::uniaxial_modes` takes it).
-    let ek = (w_e.im == 0.0).then_some(w_e.re);
-    if w_squared >= 0.0 && q.iter().all(|z| z.im == 0.0) {
+    let zero = T::zero();
+    // The e-wave's exact flux where it propagates (as `modes::uniaxial_modes` takes it).
+    let propagates = w_e.im.equals(zero);
+    let ek = (propagates.known() != Some(false)).then_some((propagates, w_e.re));
+    let real = q
+        .iter()
+        .fold(w_squared.ge(zero), |m, z| m & z.im.equals(zero));
+    if real.surely() {
         let (eps_o, eps_e) = (crystal.eps_o().re, crystal.eps_e().re);
         let fields = Fields::new(eps_o, eps_e, crystal.axis, beta);
         at.event(w_squared.sqrt(), q.map(|z| z.re), &fields, ek, sink)
@@ -102,51 +127,53 @@ pub fn each_clear_lobe(
             crystal.eps_o(),
             crystal.eps_e(),
             crystal.axis,
-            C64::new(beta, 0.0),
+            cx::real(beta),
         );
         // The up-going exterior wave: propagating, or decaying upwards beyond the critical angle.
-        let w = if w_squared >= 0.0 {
-            C64::new(w_squared.sqrt(), 0.0)
-        } else {
-            C64::new(0.0, (-w_squared).sqrt())
-        };
+        let w = w_squared.ge(zero).when(
+            || Cx::new(w_squared.safe_sqrt(), zero),
+            || Cx::new(zero, (-w_squared).safe_sqrt()),
+        );
         at.event(w, q, &fields, ek, sink)
     }
 }
 
 /// The geometry of one event.
-struct At<'a> {
-    frame: &'a PlaneFrame,
-    beta: f64,
+struct At<'a, T: Real> {
+    frame: &'a PlaneFrame<T>,
+    beta: T,
     /// The exterior's index.
-    eta: f64,
-    towards_light: Vector3<f64>,
+    eta: T,
+    towards_light: Vector3<T>,
     incident: Incident,
+    /// The lanes whose failures count ([`clear_event`]).
+    live: T::Mask,
 }
 
-impl At<'_> {
+impl<T: Real> At<'_, T> {
     /// The event with the exterior's up-going normal component `w`, the crystal's normal
-    /// components `q = [o↓, e↓, o↑, e↑]` and fields, and the up-going e-wave's `(εk)_z` if it
-    /// propagates: its lobes to `sink` ([`each_clear_lobe`]).
-    fn event<T: Scalar<f64>>(
+    /// components `q = [o↓, e↓, o↑, e↑]` and fields, and the up-going e-wave's `(εk)_z` where it
+    /// propagates: its lobes to `sink` ([`clear_event`]).
+    fn event<S: Scalar<T>>(
         &self,
-        w: T,
-        q: [T; 4],
-        fields: &Fields<T>,
-        ek: Option<f64>,
-        sink: &mut impl FnMut(&Arrival, bool, &Lobe),
-    ) -> Result<Arrival> {
+        w: S,
+        q: [S; 4],
+        fields: &Fields<S, T>,
+        ek: Option<(T::Mask, T)>,
+        sink: &mut impl FnMut(&Arrival<T>, bool, &Lobe<T>, T::Mask),
+    ) -> Result<Arrival<T>> {
         let down = [
             fields.ordinary(q[0]),
-            fields.extraordinary(q[1], ek.map(|w| (true, -w))),
+            fields.extraordinary(q[1], ek.map(|(m, w)| (m, -w))),
         ];
-        let fresnel = UniaxialFresnel::new(T::one() * self.eta, w, [psi(&down[0]), psi(&down[1])])
-            .ok_or_else(singular)?;
-        let zero = T::zero();
+        let (fresnel, degenerate) =
+            UniaxialFresnel::solved(S::one() * self.eta, w, [psi(&down[0]), psi(&down[1])]);
+        (self.live & degenerate).fail(singular)?;
+        let zero = S::zero();
         match self.incident {
             Incident::Outside => {
                 // The incident s and p waves carry the same flux, ½ w.
-                let p_in = incoming_power(0.5 * w.re())?;
+                let (p_in, _) = self.incoming_power(w.re() * 0.5)?;
                 let arrival = Arrival {
                     direction: -self.towards_light,
                     stokes_x: self.frame.s,
@@ -169,11 +196,11 @@ impl At<'_> {
             }
             Incident::Inside(kind) => {
                 let (up, q_in) = match kind {
-                    ModeKind::E => (fields.extraordinary(q[3], ek.map(|w| (true, w))), q[3]),
+                    ModeKind::E => (fields.extraordinary(q[3], ek), q[3]),
                     _ => (fields.ordinary(q[2]), q[2]),
                 };
-                let p_in = incoming_power(up.flux.abs())?;
-                let ray = self.ray(q_in, &up);
+                let (p_in, carried) = self.incoming_power(up.flux.abs())?;
+                let ray = self.ray(q_in, &up, carried);
                 let arrival = Arrival {
                     direction: -self.towards_light,
                     stokes_x: ray.stokes_x,
@@ -197,24 +224,30 @@ impl At<'_> {
         }
     }
 
-    /// The exterior's outgoing s/p lobe with amplitudes `a[out][in]` to `sink`, if it carries
+    /// The exterior's outgoing s/p lobe with amplitudes `a[out][in]` to `sink`, where it carries
     /// power (not beyond the critical angle). Its s wave `E = ŷ`, `H = (−w, 0, β)` has flux
     /// `½ w`.
-    fn exterior<T: Scalar<f64>>(
+    fn exterior<S: Scalar<T>>(
         &self,
-        w: T,
-        a: [[T; 2]; 2],
-        out: &Out,
-        sink: &mut impl FnMut(&Arrival, bool, &Lobe),
+        w: S,
+        a: [[S; 2]; 2],
+        out: &Out<T>,
+        sink: &mut impl FnMut(&Arrival<T>, bool, &Lobe<T>, T::Mask),
     ) {
-        let flux = 0.5 * w.re();
-        let k = Vector3::new(self.beta, 0.0, w.re());
-        if !carries(flux, 1.0, (w.norm_sqr() + self.beta * self.beta).sqrt()) {
+        let flux = w.re() * 0.5;
+        let k = Vector3::new(self.beta, T::zero(), w.re());
+        let carries = carries(
+            flux,
+            T::one(),
+            (w.norm_sqr() + self.beta * self.beta).sqrt(),
+        );
+        if carries.known() == Some(false) {
             return;
         }
-        let direction = self.frame.to_local(k / k.norm());
+        let k_norm = k.dot(&k).sqrt();
+        let direction = self.frame.to_local(k / k_norm);
         let f = (flux / out.p_in).sqrt();
-        let c = |z: T| (z * f).complex();
+        let c = |z: S| (z * f).complex();
         let jones = Matrix2::new(c(a[0][0]), c(a[0][1]), c(a[1][0]), c(a[1][1]));
         // From inside, the incident crystal wave is the `x` state of its frame alone.
         let mueller = if out.reflected {
@@ -229,101 +262,106 @@ impl At<'_> {
             stokes_x: self.frame.s,
             jones,
             mueller,
-            ray_index: k.norm(),
+            ray_index: k_norm,
         };
-        sink(out.arrival, out.reflected, &lobe);
+        sink(out.arrival, out.reflected, &lobe, carries);
     }
 
     /// The outgoing crystal wave `kind` of normal component `q` and fields `wave`, with
     /// amplitudes `a` for the incoming `[s, p]` (from outside) or `[wave, —]` (from inside), to
-    /// `sink` if it carries power (not evanescent).
-    fn crystal<T: Scalar<f64>>(
+    /// `sink` where it carries power (not evanescent).
+    fn crystal<S: Scalar<T>>(
         &self,
         kind: ModeKind,
-        q: T,
-        wave: &Wave<T>,
-        a: [T; 2],
-        out: &Out,
-        sink: &mut impl FnMut(&Arrival, bool, &Lobe),
+        q: S,
+        wave: &Wave<S, T>,
+        a: [S; 2],
+        out: &Out<T>,
+        sink: &mut impl FnMut(&Arrival<T>, bool, &Lobe<T>, T::Mask),
     ) {
-        if !carries(wave.flux, size(&wave.e), size(&wave.h)) {
+        let carries = carries(wave.flux, size(&wave.e), size(&wave.h));
+        if carries.known() == Some(false) {
             return;
         }
-        let ray = self.ray(q, wave);
+        let ray = self.ray(q, wave, carries);
         let f = (wave.flux.abs() / out.p_in).sqrt();
         let (a0, a1) = ((a[0] * f).complex(), (a[1] * f).complex());
-        let zero = C64::new(0.0, 0.0);
-        let k = Vector3::new(self.beta, 0.0, q.re());
+        let zero = cx::real(T::zero());
+        let k = Vector3::new(self.beta, T::zero(), q.re());
         let lobe = Lobe {
             kind,
             direction: ray.direction,
-            wave_normal: self.frame.to_local(k / k.norm()),
+            wave_normal: self.frame.to_local(k / k.dot(&k).sqrt()),
             stokes_x: ray.stokes_x,
             jones: Matrix2::new(a0, a1, zero, zero),
             mueller: mueller::from_jones_row(a0, a1),
             ray_index: ray.index,
         };
-        sink(out.arrival, out.reflected, &lobe);
+        sink(out.arrival, out.reflected, &lobe, carries);
     }
 
-    /// The ray of a crystal wave that carries power (its field is real).
-    fn ray<T: Scalar<f64>>(&self, q: T, wave: &Wave<T>) -> Ray {
-        let re = |v: &[T; 3]| Vector3::new(v[0].re(), v[1].re(), v[2].re());
+    /// The ray of a crystal wave where it carries power (`carries`; its field is real there; in
+    /// the other lanes finite numbers).
+    fn ray<S: Scalar<T>>(&self, q: S, wave: &Wave<S, T>, carries: T::Mask) -> Ray<T> {
+        let re = |v: &[S; 3]| Vector3::new(v[0].re(), v[1].re(), v[2].re());
         let (e, h) = (re(&wave.e), re(&wave.h));
         let s = e.cross(&h);
-        let s = s / s.norm();
+        let s_norm = s.dot(&s).sqrt();
+        let s = s / carries.when(|| s_norm, T::one);
         let index = self.beta * s.x + q.re() * s.z;
         let (d, e) = (self.frame.to_local(s), self.frame.to_local(e));
-        let mut x = e - d * d.dot(&e);
-        if x.norm() < 1e-12 {
-            x = self.frame.s - d * d.dot(&self.frame.s);
-        }
+        let x = e - d * d.dot(&e);
+        let along = x.dot(&x).sqrt().lt(T::cst(1e-12));
+        let x = along.when(|| self.frame.s - d * d.dot(&self.frame.s), || x);
+        let x_norm = x.dot(&x).sqrt();
         Ray {
             direction: d,
-            stokes_x: x.normalize(),
+            stokes_x: x / carries.when(|| x_norm, T::one),
             index,
         }
+    }
+
+    /// The incident flux `p` (one where it is none) and where it carries power; the error of a
+    /// wave that carries none (exactly grazing) in the lanes of `live`.
+    fn incoming_power(&self, p: T) -> Result<(T, T::Mask)> {
+        let carried = p.gt(T::zero());
+        (self.live & !carried).fail(|| {
+            Error::new(
+                "direction",
+                "the incident wave carries no power through the surface (grazing)",
+            )
+        })?;
+        Ok((carried.when(|| p, T::one), carried))
     }
 }
 
 /// Where an event's outgoing lobes go: the incident wave, the side and its flux.
-struct Out<'a> {
-    arrival: &'a Arrival,
+struct Out<'a, T: Real> {
+    arrival: &'a Arrival<T>,
     reflected: bool,
-    p_in: f64,
+    p_in: T,
 }
 
 /// A crystal wave's ray: its direction and Stokes `x` axis (local frame) and its ray index.
-struct Ray {
-    direction: Vector3<f64>,
-    stokes_x: Vector3<f64>,
-    index: f64,
+struct Ray<T: Real> {
+    direction: Vector3<T>,
+    stokes_x: Vector3<T>,
+    index: T,
 }
 
 /// The tangential fields of a wave.
 #[inline(always)]
-fn psi<T: Scalar<f64>>(wave: &Wave<T>) -> Psi<T> {
+fn psi<T: Real, S: Scalar<T>>(wave: &Wave<S, T>) -> Psi<S> {
     [wave.e[0], wave.e[1], wave.h[0], wave.h[1]]
 }
 
 /// The Hermitian norm of a 3-vector.
-fn size<T: Scalar<f64>>(v: &[T; 3]) -> f64 {
+fn size<T: Real, S: Scalar<T>>(v: &[S; 3]) -> T {
     (v[0].norm_sqr() + v[1].norm_sqr() + v[2].norm_sqr()).sqrt()
 }
 
-/// True if a wave of normal flux `flux` and field norms `e`, `h` carries power through the
+/// Where a wave of normal flux `flux` and field norms `e`, `h` carries power through the
 /// surface: the criterion of [`crate::optics::modes::Mode::is_evanescent`].
-fn carries(flux: f64, e: f64, h: f64) -> bool {
-    flux.abs() > 1e-12 * e * h
-}
-
-/// The incident flux, or the error of a wave that carries none (exactly grazing).
-fn incoming_power(p: f64) -> Result<f64> {
-    if p.is_nan() || p <= 0.0 {
-        return Err(Error::new(
-            "direction",
-            "the incident wave carries no power through the surface (grazing)",
-        ));
-    }
-    Ok(p)
+fn carries<T: Real>(flux: T, e: T, h: T) -> T::Mask {
+    flux.abs().gt(e * 1e-12 * h)
 }

@@ -31,7 +31,11 @@ impl<T: Real> PlaneFrame<T> {
         let (x, y) = (-towards_light.x, -towards_light.y);
         let n = (x * x + y * y).sqrt();
         let zero = T::zero();
-        let (ux, uy) = n.gt(zero).when(|| (x / n, y / n), || (zero, T::cst(-1.0)));
+        let tilted = n.gt(zero);
+        // Divided by one at normal incidence, where the quotient is discarded: no lane of a
+        // recorded program computes 0/0 (whose NaN would poison Dr.Jit's derivatives).
+        let n = tilted.when(|| n, T::one);
+        let (ux, uy) = tilted.when(|| (x / n, y / n), || (zero, T::cst(-1.0)));
         Self::from_u(Vector3::new(ux, uy, zero))
     }
 

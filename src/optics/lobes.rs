@@ -16,26 +16,28 @@ use crate::optics::frame::PlaneFrame;
 use crate::optics::modes::{extraordinary_wave_vector_from_ray, Mode, ModeKind};
 use crate::optics::mueller;
 use crate::optics::surface::{Incident, Solved, Surface};
+use crate::real::complex::{self as cx, Cx};
+use crate::real::{Mask, Real};
 use nalgebra::{Matrix2, Matrix4, Vector2, Vector3};
 use num_complex::Complex64 as C64;
 
-/// One outgoing wave.
+/// One outgoing wave, over the reals `T` (`f64` on the host).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Lobe {
+pub struct Lobe<T: Real = f64> {
     /// `S` for an exterior wave (s and p together), `O` or `E` for a crystal wave.
     pub kind: ModeKind,
     /// Unit ray (Poynting) direction, local frame, pointing away from the surface.
-    pub direction: Vector3<f64>,
+    pub direction: Vector3<T>,
     /// Unit wave normal, local frame.
-    pub wave_normal: Vector3<f64>,
+    pub wave_normal: Vector3<T>,
     /// `x` axis of this wave's Stokes frame (`y = direction × x`).
-    pub stokes_x: Vector3<f64>,
+    pub stokes_x: Vector3<T>,
     /// Flux-normalised Jones matrix, incident frame → this wave's frame (core convention).
-    pub jones: Matrix2<C64>,
+    pub jones: Matrix2<Cx<T>>,
     /// Its Mueller matrix in Mitsuba's convention.
-    pub mueller: Matrix4<f64>,
+    pub mueller: Matrix4<T>,
     /// Ray index of the outgoing wave (eq. S14).
-    pub ray_index: f64,
+    pub ray_index: T,
 }
 
 /// All lobes of one surface event.
@@ -65,7 +67,7 @@ pub fn scatter(
     towards_light: Vector3<f64>,
     incident: Incident,
 ) -> Result<Event> {
-    let (frame, beta) = incidence(surface, towards_light, incident)?;
+    let (frame, beta) = incidence(surface, towards_light, incident, true)?;
     let sv = surface.solve(frame, beta)?;
     let i = &sv.interface;
     let iso = surface.crystal.is_isotropic();
@@ -164,37 +166,41 @@ impl Group {
     }
 }
 
-/// The plane of incidence and `β` for a wave arriving from `towards_light`.
-pub(crate) fn incidence(
-    surface: &Surface,
-    towards_light: Vector3<f64>,
+/// The plane of incidence and `β` for a wave arriving from `towards_light`. The lanes of `live`
+/// (a recorded event that other lanes discard) fail where the direction is not unit or on the
+/// wrong side.
+pub(crate) fn incidence<T: Real>(
+    surface: &Surface<T>,
+    towards_light: Vector3<T>,
     incident: Incident,
-) -> Result<(PlaneFrame, C64)> {
-    let n = towards_light.norm();
-    if !n.is_finite() || (n - 1.0).abs() > 1e-6 {
-        return Err(Error::new("direction", "must be a unit vector"));
-    }
+    live: T::Mask,
+) -> Result<(PlaneFrame<T>, Cx<T>)> {
+    let n = towards_light.dot(&towards_light).sqrt();
+    let unit = n.finite() & (n - T::one()).abs().le(T::cst(1e-6));
+    (live & !unit).fail(|| Error::new("direction", "must be a unit vector"))?;
     let outside = matches!(incident, Incident::Outside);
-    if (towards_light.z > 0.0) != outside {
-        return Err(Error::new(
+    let above = towards_light.z.gt(T::zero());
+    let wrong_side = if outside { !above } else { above };
+    (live & wrong_side).fail(|| {
+        Error::new(
             "direction",
             "must point into the exterior (z > 0) for outside incidence, into the crystal (z < 0) for inside",
-        ));
-    }
+        )
+    })?;
     // The wave normal (in the direction the light travels) decides the plane of incidence.
     let ray = -towards_light;
     let k = match incident {
         Incident::Outside => ray * surface.exterior.eta_o.re,
-        Incident::Inside(ModeKind::E) if !surface.crystal.is_isotropic() => {
+        Incident::Inside(ModeKind::E) if !surface.crystal.is_isotropic().surely() => {
             extraordinary_wave_vector_from_ray(&surface.crystal, ray)
         }
         Incident::Inside(_) => ray * surface.crystal.eta_o.re,
     };
     let frame = PlaneFrame::from_direction(-k);
-    let beta = frame.to_working(k).x.max(0.0);
+    let beta = frame.to_working(k).x.max(T::zero());
     let beta = match incident {
         Incident::Outside => surface.exterior.eta_o * (beta / surface.exterior.eta_o.re),
-        _ => C64::new(beta, 0.0),
+        _ => cx::real(beta),
     };
     Ok((frame, beta))
 }

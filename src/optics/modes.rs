@@ -270,7 +270,7 @@ fn extraordinary_q_w<T: Real>(medium: &Uniaxial<T>, beta: Cx<T>) -> (Cx<T>, Cx<T
         let c = |x: T| cx::real(x);
         return disc.ge(T::zero()).when(
             || {
-                let w = disc.sqrt();
+                let w = disc.safe_sqrt();
                 let inv_a = Scalar::inverse(a);
                 let w = (w * inv_a).lt(T::zero()).when(|| -w, || w);
                 (c((w - b) * inv_a), c((-w - b) * inv_a), c(w))
@@ -390,10 +390,13 @@ fn uniaxial_pairs<T: Real, S: Scalar<T>>(
 ///
 /// The e-wave's ray is the normal of its index surface `kᵀ ε k = ε_o ε_e`, i.e. `∝ ε k`, hence
 /// `k = ε⁻¹ ŝ · sqrt(ε_o ε_e / ŝᵀ ε⁻¹ ŝ)`. Absorption is ignored (real parts of ε are used).
-pub fn extraordinary_wave_vector_from_ray(medium: &Uniaxial, ray: Vector3<f64>) -> Vector3<f64> {
+pub fn extraordinary_wave_vector_from_ray<T: Real>(
+    medium: &Uniaxial<T>,
+    ray: Vector3<T>,
+) -> Vector3<T> {
     let (eo, ee) = (medium.eps_o().re, medium.eps_e().re);
     let a = medium.axis;
-    let inv = |v: Vector3<f64>| v / eo + a * (a.dot(&v) * (1.0 / ee - 1.0 / eo));
+    let inv = |v: Vector3<T>| v / eo + a * (a.dot(&v) * (ee.recip() - eo.recip()));
     let k = inv(ray);
     k * (eo * ee / ray.dot(&k)).sqrt()
 }

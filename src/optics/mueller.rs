@@ -6,7 +6,7 @@
 //! the Mueller matrix is `M = Re(A (J_m ⊗ J_m*) A⁻¹)`, `J_m = conj(J)`,
 //! `A = [[1,0,0,1],[1,0,0,−1],[0,1,1,0],[0,i,−i,0]]`. Written out below entry by entry.
 
-use crate::real::complex::Cx;
+use crate::real::complex::{self as cx, Cx};
 use crate::real::Real;
 use nalgebra::{Matrix2, Matrix4};
 use num_complex::Complex64 as C64;
@@ -50,21 +50,21 @@ pub fn from_jones<T: Real>(j: &Matrix2<Cx<T>>) -> Matrix4<T> {
 /// [`from_jones`] of `[[a, b], [0, 0]]` (light leaving in the `x` state of its frame only, as a
 /// crystal wave does), written out: rows 0 and 1 are
 /// `(½(|a|² + |b|²), ½(|a|² − |b|²), Re(ā b), Im(ā b))`, rows 2 and 3 zero.
-pub fn from_jones_row(a: C64, b: C64) -> Matrix4<f64> {
-    let (p, r) = (a.norm_sqr(), b.norm_sqr());
+pub fn from_jones_row<T: Real>(a: Cx<T>, b: Cx<T>) -> Matrix4<T> {
+    let (p, r) = (cx::norm_sqr(a), cx::norm_sqr(b));
     let w = a.conj() * b;
-    let row = [0.5 * (p + r), 0.5 * (p - r), w.re, w.im];
-    Matrix4::from_fn(|i, j| if i < 2 { row[j] } else { 0.0 })
+    let row = [(p + r) * 0.5, (p - r) * 0.5, w.re, w.im];
+    Matrix4::from_fn(|i, j| if i < 2 { row[j] } else { T::zero() })
 }
 
 /// [`from_jones`] of `[[a, 0], [c, 0]]` (light arriving in the `x` state of its frame only, as a
 /// crystal wave does), written out: columns 0 and 1 are
 /// `(½(|a|² + |c|²), ½(|a|² − |c|²), Re(c̄ a), Im(c̄ a))`, columns 2 and 3 zero.
-pub fn from_jones_column(a: C64, c: C64) -> Matrix4<f64> {
-    let (p, q) = (a.norm_sqr(), c.norm_sqr());
+pub fn from_jones_column<T: Real>(a: Cx<T>, c: Cx<T>) -> Matrix4<T> {
+    let (p, q) = (cx::norm_sqr(a), cx::norm_sqr(c));
     let x = c.conj() * a;
-    let column = [0.5 * (p + q), 0.5 * (p - q), x.re, x.im];
-    Matrix4::from_fn(|i, j| if j < 2 { column[i] } else { 0.0 })
+    let column = [(p + q) * 0.5, (p - q) * 0.5, x.re, x.im];
+    Matrix4::from_fn(|i, j| if j < 2 { column[i] } else { T::zero() })
 }
 
 /// The coherency superoperator `K(J) = J_m ⊗ conj(J_m) = conj(J) ⊗ J`: it maps the vectorised
@@ -86,13 +86,14 @@ pub fn cross(j1: &Matrix2<C64>, j2: &Matrix2<C64>) -> Matrix4<C64> {
 /// `sp = conj(a) b`, `pp = |b|²` (or their averages). `from_coherency` written out:
 /// `M₀₀ = M₁₁ = (ss + pp)/2`, `M₀₁ = M₁₀ = (ss − pp)/2`, `M₂₂ = M₃₃ = Re sp`,
 /// `M₂₃ = −M₃₂ = Im sp`.
-pub fn from_diagonal(ss: f64, sp: C64, pp: f64) -> Matrix4<f64> {
-    let (a, d) = (0.5 * (ss + pp), 0.5 * (ss - pp));
+pub fn from_diagonal<T: Real>(ss: T, sp: Cx<T>, pp: T) -> Matrix4<T> {
+    let (a, d) = ((ss + pp) * 0.5, (ss - pp) * 0.5);
+    let z = T::zero();
     Matrix4::new(
-        a, d, 0.0, 0.0, //
-        d, a, 0.0, 0.0, //
-        0.0, 0.0, sp.re, sp.im, //
-        0.0, 0.0, -sp.im, sp.re,
+        a, d, z, z, //
+        d, a, z, z, //
+        z, z, sp.re, sp.im, //
+        z, z, -sp.im, sp.re,
     )
 }
 

@@ -11,6 +11,7 @@ use crate::optics::frame::PlaneFrame;
 use crate::optics::interface::Interface;
 use crate::optics::medium::Uniaxial;
 use crate::optics::modes::{index_along, k_max, Mode, ModeKind};
+use crate::real::Real;
 use nalgebra::Vector3;
 use num_complex::Complex64 as C64;
 
@@ -23,13 +24,14 @@ pub enum Incident {
     Inside(ModeKind),
 }
 
-/// An isotropic exterior over a uniaxial crystal whose optic axis is given in the local frame.
+/// An isotropic exterior over a uniaxial crystal whose optic axis is given in the local frame,
+/// over the reals `T` (`f64` on the host).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Surface {
+pub struct Surface<T: Real = f64> {
     /// The exterior medium (isotropic).
-    pub exterior: Uniaxial,
+    pub exterior: Uniaxial<T>,
     /// The crystal, optic axis in the local frame.
-    pub crystal: Uniaxial,
+    pub crystal: Uniaxial<T>,
 }
 
 /// A solved surface: the interface in the plane-of-incidence frame, and that frame.
@@ -46,11 +48,6 @@ impl Surface {
     pub fn new(ext: C64, crystal: Uniaxial) -> Result<Self> {
         let exterior = Uniaxial::isotropic(check_clear_index("ext_ior", ext)?)?;
         Ok(Surface { exterior, crystal })
-    }
-
-    /// The crystal with its optic axis expressed in the working frame of `frame`.
-    pub fn crystal_in(&self, frame: &PlaneFrame) -> Uniaxial {
-        self.crystal.with_axis(frame.to_working(self.crystal.axis))
     }
 
     /// Incidence parameter `β = η sin θ` (eq. S1) of a wave whose wave normal makes the
@@ -79,6 +76,13 @@ impl Surface {
     /// `(K_o^max, K_e^max)/k0` of the crystal in the plane of `frame` (eq. S15).
     pub fn k_max(&self, frame: &PlaneFrame) -> (C64, C64) {
         k_max(&self.crystal_in(frame))
+    }
+}
+
+impl<T: Real> Surface<T> {
+    /// The crystal with its optic axis expressed in the working frame of `frame`.
+    pub fn crystal_in(&self, frame: &PlaneFrame<T>) -> Uniaxial<T> {
+        self.crystal.with_axis(frame.to_working(self.crystal.axis))
     }
 }
 

@@ -34,14 +34,17 @@
 //! (`tests/interface_fast_path.rs`).
 
 use crate::cmath::Scalar;
+use crate::real::{Mask, Real};
+use std::marker::PhantomData;
 
 /// Tangential fields `(E_x, E_y, H_x, H_y)` of a mode.
 pub type Psi<T> = [T; 4];
 
 /// The interface for one incidence parameter: the isotropic side and the crystal's down-going
-/// modes, with `M⁻¹` by Cramer's rule.
+/// modes, with `M⁻¹` by Cramer's rule; in the arithmetic `T` over the reals `R`
+/// ([`crate::real`]).
 #[derive(Clone, Copy, Debug)]
-pub struct UniaxialFresnel<T> {
+pub struct UniaxialFresnel<T, R = f64> {
     /// `η` of the isotropic medium.
     eta: T,
     /// `w` of its up-going waves.
@@ -52,32 +55,48 @@ pub struct UniaxialFresnel<T> {
     m: [[T; 2]; 2],
     /// `1 / det M`.
     inv_det: T,
+    reals: PhantomData<R>,
 }
 
 impl<T: Scalar<f64>> UniaxialFresnel<T> {
     /// The interface between an isotropic medium of index `eta` above (its up-going normal
     /// component `w`) and a crystal whose down-going modes have the tangential fields `down`.
-    /// `None` if `M` is singular to working precision (a guided or surface wave; the criterion
-    /// of [`crate::cmath::solve4`]: `|det M|` below `1e-150` of the largest product of entries).
+    /// `None` if `M` is singular to working precision ([`UniaxialFresnel::solved`]).
     #[inline]
     pub fn new(eta: T, w: T, down: [Psi<T>; 2]) -> Option<Self> {
+        let (fresnel, singular) = Self::solved(eta, w, down);
+        (!singular).then_some(fresnel)
+    }
+}
+
+impl<R: Real, T: Scalar<R>> UniaxialFresnel<T, R> {
+    /// [`UniaxialFresnel::new`] over the reals `R`: the interface, and where `M` is singular to
+    /// working precision (a guided or surface wave; the criterion of
+    /// [`crate::cmath::solve4`]: `|det M|` below `1e-150` of the largest product of entries), in
+    /// which lanes its amplitudes are those of `det M = 1` (finite, and meaningless).
+    #[inline]
+    pub fn solved(eta: T, w: T, down: [Psi<T>; 2]) -> (Self, R::Mask) {
         let eps = eta * eta;
         let form = |p: &Psi<T>| (w * p[1] + p[2], eps * p[0] - w * p[3]);
         let ((s_o, p_o), (s_e, p_e)) = (form(&down[0]), form(&down[1]));
         let m = [[s_o, s_e], [p_o, p_e]];
         let det = s_o * p_e - s_e * p_o;
-        let scale = m.iter().flatten().map(|z| z.norm_sqr()).fold(0.0, f64::max);
+        let scale = m
+            .iter()
+            .flatten()
+            .map(|z| z.norm_sqr())
+            .fold(R::zero(), |a, x| a.max(x));
         let n = det.norm_sqr();
-        if !n.is_finite() || n <= 1e-300 * scale * scale {
-            return None;
-        }
-        Some(UniaxialFresnel {
+        let singular = !n.finite() | n.le(scale * 1e-300 * scale);
+        let fresnel = UniaxialFresnel {
             eta,
             w,
             down,
             m,
-            inv_det: det.inverse(),
-        })
+            inv_det: singular.when(T::one, || det).inverse(),
+            reals: PhantomData,
+        };
+        (fresnel, singular)
     }
 
     /// Waves arriving from above with unit amplitudes: `(r, t)`, `r[out][in]` with outgoing
@@ -85,7 +104,7 @@ impl<T: Scalar<f64>> UniaxialFresnel<T> {
     #[inline]
     pub fn from_above(&self) -> ([[T; 2]; 2], [[T; 2]; 2]) {
         let (m, k) = (&self.m, self.inv_det);
-        let two_w = self.w * 2.0;
+        let two_w = self.w * R::cst(2.0);
         let (s_in, p_in) = (two_w * k, two_w * self.eta * k);
         let t = [
             [m[1][1] * s_in, -(m[0][1] * p_in)],

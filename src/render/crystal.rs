@@ -1,5 +1,9 @@
 //! The lobes of a bulk crystal's surface (reflection, ordinary and extraordinary refraction)
-//! as a path tracer samples them (see [`crate::render`] for the transport modes).
+//! as a path tracer samples them (see [`crate::render`] for the transport modes), over the
+//! reals of [`crate::real`]: on the host, and recorded as the program the shim replays
+//! ([`sample_exact`]). A decision about a lane (the side `wi` looks from, total internal
+//! reflection, an isotropic or absorbing crystal whose indices are a program's inputs) is a
+//! mask there, and the lobes of every outcome are kept with the masks of their lanes.
 //!
 //! **An absorbing bulk medium is opaque**, as Mitsuba's `conductor` is: light refracted into a
 //! crystal with any `κ > 0` (only isotropic ones are accepted, see [`crystal_lobes`]) is
@@ -15,26 +19,25 @@
 //! weight: 47,000 for silver at normal incidence). [`opaque`] makes this decision.
 
 use crate::error::{Error, Result};
-use crate::optics::clear_lobes::{self, each_clear_lobe, Arrival};
+use crate::material::{check_clear_index, Material};
+use crate::optics::clear_lobes::{clear_event, Arrival};
 use crate::optics::lobes::{scatter, Lobe};
+use crate::optics::medium::Uniaxial;
 use crate::optics::modes::ModeKind;
 use crate::optics::mueller::reversed;
 use crate::optics::surface::{Incident, Surface};
+use crate::plate::slab::Output;
+use crate::real::complex as cx;
+use crate::real::{Mask, Real, Select};
+use crate::render::choice::{self, Sampled};
 use crate::render::isotropic;
-use crate::render::slots::{crystal_slot, Slots, CRYSTAL_SLOTS};
+use crate::render::slots::{crystal_component, crystal_slot, Slots, CRYSTAL_SLOTS};
 use crate::render::{PathLobe, Transport};
-use nalgebra::Vector3;
+use nalgebra::{Matrix4, Vector3};
+use num_complex::Complex64 as C64;
 
-/// How a surface event is computed: the closed form of [`crate::optics::clear_lobes`] where it
-/// applies, or always the general interface solve (the reference).
-#[derive(Clone, Copy, PartialEq, Eq)]
-enum Solve {
-    Fastest,
-    General,
-}
-
-/// Lobes of a bulk crystal surface seen from `wi` (unit, local; `wi.z < 0` is inside). A
-/// lossless isotropic crystal takes the closed form of [`crate::render::isotropic`], a lossless
+/// Lobes of a bulk crystal surface seen from `wi` (unit, local; `wi.z < 0` is inside). An
+/// isotropic crystal takes the closed form of [`crate::render::isotropic`], a lossless
 /// birefringent one that of [`crate::optics::clear_lobes`]. Absorbing anisotropic crystals are
 /// refused (an error naming `kappa_o` or `kappa_e`): their per-ray powers are not defined (see
 /// the error message); isotropic absorbing media (metals, lossy dielectrics) are opaque, with
@@ -45,43 +48,53 @@ pub fn crystal_lobes(
     transport: Transport,
 ) -> Result<Vec<PathLobe>> {
     refuse_absorbing_birefringence(surface)?;
-    let Some(wi) = checked_direction(wi)? else {
+    let Some((wi, lit)) = checked_direction(wi)? else {
         return Ok(Vec::new());
     };
     // At most six lobes (from inside: each crystal wave's two reflections and refraction).
     let mut lobes = Vec::with_capacity(6);
-    if let Some((reflection, refraction)) = isotropic::crystal_lobes(surface, wi, transport) {
-        lobes.push(reflection);
-        lobes.extend(refraction);
-        return Ok(lobes);
-    }
-    each_lobe(surface, wi, transport, Solve::Fastest, |_, l| lobes.push(l))?;
+    each_lobe(surface, wi, lit, transport, |_, l| lobes.push(l))?;
     Ok(lobes)
 }
 
 /// Absorbing anisotropic crystals are refused (see [`crystal_lobes`]), naming the absorbing
-/// index's parameter.
-fn refuse_absorbing_birefringence(surface: &Surface) -> Result<()> {
-    if !surface.crystal.is_isotropic() && !surface.crystal.is_lossless() {
-        let absorbing = if surface.crystal.eta_o.im != 0.0 {
+/// index's parameter; while recording, the lanes where the crystal is both.
+fn refuse_absorbing_birefringence<T: Real>(surface: &Surface<T>) -> Result<()> {
+    let c = &surface.crystal;
+    (!c.is_isotropic() & !c.is_lossless()).fail(|| {
+        let absorbing = if c.eta_o.im.value() != Some(0.0) {
             "kappa_o"
         } else {
             "kappa_e"
         };
-        return Err(Error::new(
+        Error::new(
             absorbing,
             "an absorbing birefringent crystal cannot be rendered as a bulk surface: inside it the o and e waves are not power-orthogonal (their fluxes do not add), so the power of each refracted ray is undefined and lobe weights would not conserve energy. Use thinbirefringent for a dichroic plate (its transmission is exact), or kappa_o = kappa_e = 0 here",
-        ));
-    }
-    Ok(())
+        )
+    })
 }
 
-/// `wi` normalised, `None` at exactly grazing incidence (no lobes); an error unless unit.
-fn checked_direction(wi: Vector3<f64>) -> Result<Option<Vector3<f64>>> {
-    if !(wi.iter().all(|x| x.is_finite()) && (wi.norm() - 1.0).abs() < 1e-4) {
-        return Err(Error::new("wi", "must be a unit vector"));
+/// `wi` normalised, and where it is not exactly grazing (no lobes there); `None` where that is
+/// known; an error unless unit. While recording, lanes that are not unit or graze compute on
+/// the normal instead (finite numbers, and no light).
+fn checked_direction<T: Real>(wi: Vector3<T>) -> Result<Option<(Vector3<T>, T::Mask)>> {
+    let finite = wi.iter().fold(T::Mask::cst(true), |m, x| m & x.finite());
+    let norm = wi.dot(&wi).sqrt();
+    let unit = finite & (norm - T::one()).abs().lt(T::cst(1e-4));
+    (!unit).fail(|| Error::new("wi", "must be a unit vector"))?;
+    let grazing = wi.z.equals(T::zero());
+    if grazing.surely() {
+        return Ok(None);
     }
-    Ok((wi.z != 0.0).then(|| wi.normalize()))
+    let wi = wi / norm;
+    let unsafe_lane = !unit | grazing;
+    let wi = if unsafe_lane.known() == Some(false) {
+        wi
+    } else {
+        let (zero, one) = (T::zero(), T::one());
+        Select::select(unsafe_lane, Vector3::new(zero, zero, one), wi)
+    };
+    Ok(Some((wi, !grazing)))
 }
 
 /// [`crystal_lobes`] by the general computation (every case, isotropic and clear crystals
@@ -91,92 +104,177 @@ pub fn crystal_lobes_full(
     wi: Vector3<f64>,
     transport: Transport,
 ) -> Result<Vec<PathLobe>> {
-    let Some(wi) = checked_direction(wi)? else {
+    let Some((wi, _)) = checked_direction(wi)? else {
         return Ok(Vec::new());
     };
     let mut lobes = Vec::new();
-    each_lobe(surface, wi, transport, Solve::General, |_, l| lobes.push(l))?;
+    each_general_lobe(surface, wi, transport, |_, l| lobes.push(l))?;
     Ok(lobes)
 }
 
-/// The lobes of [`crystal_lobes`] in their fixed slots ([`crate::render::slots`]): the same
-/// lobes, bit for bit, each at the index of the two waves it joins.
-pub fn crystal_slots(
+/// [`crystal_slots`] by the general computation ([`crystal_lobes_full`] in slots): the reference
+/// of the recorded program's tests.
+pub fn crystal_slots_full(
     surface: &Surface,
     wi: Vector3<f64>,
     transport: Transport,
 ) -> Result<Slots<CRYSTAL_SLOTS>> {
+    let mut slots = [None; CRYSTAL_SLOTS];
+    if let Some((wi, _)) = checked_direction(wi)? {
+        each_general_lobe(surface, wi, transport, |slot, l| slots[slot] = Some(l))?;
+    }
+    Ok(slots)
+}
+
+/// The lobes of [`crystal_lobes`] in their fixed slots ([`crate::render::slots`]): the same
+/// lobes, bit for bit, each at the index of the two waves it joins; over the reals `T`.
+pub fn crystal_slots<T: Real>(
+    surface: &Surface<T>,
+    wi: Vector3<T>,
+    transport: Transport,
+) -> Result<Slots<CRYSTAL_SLOTS, T>> {
     let mut slots = [None; CRYSTAL_SLOTS];
     fill_crystal_slots(surface, wi, transport, &mut slots)?;
     Ok(slots)
 }
 
 /// [`crystal_slots`] written into `slots` (every slot is set).
-pub fn fill_crystal_slots(
-    surface: &Surface,
-    wi: Vector3<f64>,
+pub fn fill_crystal_slots<T: Real>(
+    surface: &Surface<T>,
+    wi: Vector3<T>,
     transport: Transport,
-    slots: &mut Slots<CRYSTAL_SLOTS>,
+    slots: &mut Slots<CRYSTAL_SLOTS, T>,
 ) -> Result<()> {
     *slots = [None; CRYSTAL_SLOTS];
     refuse_absorbing_birefringence(surface)?;
-    let Some(wi) = checked_direction(wi)? else {
+    let Some((wi, lit)) = checked_direction(wi)? else {
         return Ok(());
     };
-    if let Some((reflection, refraction)) = isotropic::crystal_lobes(surface, wi, transport) {
-        // Reflection (component 0) and refraction (1) of an isotropic crystal, whose rays
-        // count as o-rays.
-        let crystal = Some(ModeKind::O);
-        let (near, far) = if wi.z < 0.0 {
-            (crystal, None)
-        } else {
-            (None, crystal)
-        };
-        slots[crystal_slot(near, near)] = Some(reflection);
-        slots[crystal_slot(near, far)] = refraction;
-        return Ok(());
-    }
-    each_lobe(surface, wi, transport, Solve::Fastest, |slot, l| {
-        slots[slot] = Some(l)
+    each_lobe(surface, wi, lit, transport, |slot, l| {
+        put(&mut slots[slot], l)
     })
 }
 
-/// Calls `f(slot, lobe)` for every lobe seen from `wi` (unit, `wi.z != 0`), each event computed
-/// as `solve` says.
-fn each_lobe(
+/// `lobe` into `slot`: where the slot already holds a lobe of other lanes (another outcome of
+/// a decision about the lanes), each lane keeps the one that exists there.
+fn put<T: Real>(slot: &mut Option<PathLobe<T>>, lobe: PathLobe<T>) {
+    *slot = Some(match *slot {
+        Some(old) if old.exists.known() != Some(false) => PathLobe {
+            exists: lobe.exists | old.exists,
+            ..Select::select(lobe.exists, lobe, old)
+        },
+        _ => lobe,
+    });
+}
+
+/// Calls `f(slot, lobe)` for every lobe seen from `wi` (unit; where `lit`, not grazing): those
+/// of the isotropic closed form where the crystal is isotropic, of the clear birefringent one
+/// elsewhere.
+fn each_lobe<T: Real>(
+    surface: &Surface<T>,
+    wi: Vector3<T>,
+    lit: T::Mask,
+    transport: Transport,
+    mut f: impl FnMut(usize, PathLobe<T>),
+) -> Result<()> {
+    let iso = surface.crystal.is_isotropic();
+    let outside = wi.z.gt(T::zero());
+    if iso.known() != Some(false) {
+        let live = iso & lit;
+        isotropic::each_lobe(surface, wi, outside, transport, |slot, l| {
+            f(slot, l.existing(live))
+        })?;
+    }
+    if iso.known() != Some(true) {
+        let live = !iso & lit;
+        birefringent_lobes(surface, wi, outside, transport, live, |slot, l| {
+            f(slot, l.existing(live))
+        })?;
+    }
+    Ok(())
+}
+
+/// The lobes of a clear birefringent crystal seen from `wi` (`outside`: where `wi.z > 0`), each
+/// to `f(slot, lobe)`; the lanes of `live` fail where an event cannot be computed. Light from
+/// inside arrives along each crystal wave that can travel there. Both sides are computed where
+/// the side is not known, each from `wi` mirrored to its side.
+fn birefringent_lobes<T: Real>(
+    surface: &Surface<T>,
+    wi: Vector3<T>,
+    outside: T::Mask,
+    transport: Transport,
+    live: T::Mask,
+    mut f: impl FnMut(usize, PathLobe<T>),
+) -> Result<()> {
+    // Lanes where the crystal absorbs are refused (or isotropic: opaque), so the events may
+    // take the real parts of its indices (finite numbers in every lane, and lossless
+    // arithmetic).
+    let c = surface.crystal;
+    let surface = if c.is_lossless().surely() {
+        *surface
+    } else {
+        Surface {
+            crystal: Uniaxial {
+                eta_o: cx::real(c.eta_o.re),
+                eta_e: cx::real(c.eta_e.re),
+                axis: c.axis,
+            },
+            ..*surface
+        }
+    };
+    let mut event = |mode: Option<ModeKind>, side: T::Mask, towards: Vector3<T>| {
+        let incident = mode.map_or(Incident::Outside, Incident::Inside);
+        clear_event(
+            &surface,
+            towards,
+            incident,
+            live & side,
+            |arrival, reflected, l, carries| {
+                if let Some((slot, lobe)) = path_lobe(arrival, mode, reflected, l, false, transport)
+                {
+                    f(slot, lobe.existing(carries & side));
+                }
+            },
+        )
+        .map(|_| ())
+    };
+    if outside.known() != Some(false) {
+        event(None, outside, Vector3::new(wi.x, wi.y, wi.z.abs()))?;
+    }
+    if outside.known() != Some(true) {
+        let inside = Vector3::new(wi.x, wi.y, -wi.z.abs());
+        event(Some(ModeKind::O), !outside, inside)?;
+        event(Some(ModeKind::E), !outside, inside)?;
+    }
+    Ok(())
+}
+
+/// Calls `f(slot, lobe)` for every lobe seen from `wi` (unit, `wi.z != 0`), each event
+/// through the general interface solve ([`scatter`]).
+fn each_general_lobe(
     surface: &Surface,
     wi: Vector3<f64>,
     transport: Transport,
-    solve: Solve,
     mut f: impl FnMut(usize, PathLobe),
 ) -> Result<()> {
     let opaque = opaque(surface);
     if wi.z < 0.0 && opaque {
         return Ok(()); // no light inside an opaque bulk
     }
-    let clear = solve == Solve::Fastest && clear_lobes::applies(surface);
     // The lobes of light arriving as the crystal wave `mode` (`None`: from the exterior).
     let mut event = |mode: Option<ModeKind>| -> Result<()> {
         let incident = mode.map_or(Incident::Outside, Incident::Inside);
-        let mut out = |arrival: &Arrival, reflected: bool, l: &Lobe| {
-            if let Some((slot, lobe)) = path_lobe(arrival, mode, reflected, l, opaque, transport) {
-                f(slot, lobe);
-            }
+        let e = scatter(surface, wi, incident)?;
+        let arrival = Arrival {
+            direction: e.incident_direction,
+            stokes_x: e.incident_stokes_x,
+            ray_index: e.incident_ray_index,
         };
-        if clear {
-            each_clear_lobe(surface, wi, incident, out)?;
-        } else {
-            let e = scatter(surface, wi, incident)?;
-            let arrival = Arrival {
-                direction: e.incident_direction,
-                stokes_x: e.incident_stokes_x,
-                ray_index: e.incident_ray_index,
-            };
-            for l in e.reflected.iter().flatten() {
-                out(&arrival, true, l);
-            }
-            for l in e.transmitted.iter().flatten() {
-                out(&arrival, false, l);
+        let lobes = e.reflected.iter().map(|l| (true, l));
+        for (reflected, l) in lobes.chain(e.transmitted.iter().map(|l| (false, l))) {
+            let Some(l) = l else { continue };
+            if let Some((slot, lobe)) = path_lobe(&arrival, mode, reflected, l, opaque, transport) {
+                f(slot, lobe);
             }
         }
         Ok(())
@@ -184,7 +282,6 @@ fn each_lobe(
     if wi.z > 0.0 {
         return event(None);
     }
-    // Light arrives from inside along each crystal wave that can travel there.
     event(Some(ModeKind::O))?;
     if !surface.crystal.is_isotropic() {
         event(Some(ModeKind::E))?;
@@ -196,14 +293,14 @@ fn each_lobe(
 /// `arrival` in the crystal mode `incident` (`None`: from the exterior): a reflection is
 /// component 0, a transmission 1 or 2 by its crystal-side mode; `None` for a refraction into an
 /// `opaque` bulk (absorbed at the surface).
-fn path_lobe(
-    arrival: &Arrival,
+fn path_lobe<T: Real>(
+    arrival: &Arrival<T>,
     incident: Option<ModeKind>,
     reflected: bool,
-    l: &Lobe,
+    l: &Lobe<T>,
     opaque: bool,
     transport: Transport,
-) -> Option<(usize, PathLobe)> {
+) -> Option<(usize, PathLobe<T>)> {
     let component = match (reflected, incident.unwrap_or(l.kind)) {
         (true, _) => 0,
         (false, ModeKind::E) => 2,
@@ -228,14 +325,17 @@ fn path_lobe(
             l.mueller,
             ratio,
         ),
-        Transport::Radiance => PathLobe::new(
-            component,
-            l.direction,
-            (l.stokes_x, arrival.stokes_x),
-            reversed(&l.mueller),
-            ratio,
-        )
-        .with_radiance_factor((arrival.ray_index / l.ray_index).powi(2)),
+        Transport::Radiance => {
+            let factor = arrival.ray_index / l.ray_index;
+            PathLobe::new(
+                component,
+                l.direction,
+                (l.stokes_x, arrival.stokes_x),
+                reversed(&l.mueller),
+                ratio,
+            )
+            .with_radiance_factor(factor * factor)
+        }
     };
     Some((crystal_slot(incident, mode), lobe))
 }
@@ -244,4 +344,93 @@ fn path_lobe(
 /// at the surface and none arrives from inside (see the module documentation).
 pub fn opaque(surface: &Surface) -> bool {
     !surface.crystal.is_lossless()
+}
+
+/// A crystal query at exact wavelengths, over the reals `T`: what a spectral renderer asks at
+/// the wavelengths it traces along a path, on the host (`f64`) or recorded as a program
+/// ([`crate::record`]) whose inputs are the path's and the crystal's per-lane values.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ExactCrystal<T: Real = f64> {
+    /// The crystal's material.
+    pub material: Material<T>,
+    /// The exterior's (real) index.
+    pub ext: T,
+    /// The optic axis, local frame (any non-zero length: normalised at each wavelength).
+    pub axis: Vector3<T>,
+    /// Only `M00` of each lobe (the others zero).
+    pub output: Output,
+}
+
+impl ExactCrystal {
+    /// A validated query: a real exterior index, a finite non-zero axis.
+    pub fn new(
+        material: Material,
+        ext: f64,
+        axis: Vector3<f64>,
+        intensity_only: bool,
+    ) -> Result<Self> {
+        let ext = check_clear_index("ext_ior", C64::new(ext, 0.0))?.re;
+        Uniaxial::new(C64::new(1.0, 0.0), C64::new(1.5, 0.0), axis)?;
+        Ok(ExactCrystal {
+            material,
+            ext,
+            axis,
+            output: if intensity_only {
+                Output::Intensity
+            } else {
+                Output::Mueller
+            },
+        })
+    }
+}
+
+impl<T: Real> ExactCrystal<T> {
+    /// The surface at `lambda_nm` (the indices there are checked).
+    pub fn surface_at(&self, lambda_nm: T) -> Result<Surface<T>> {
+        let (eta_o, eta_e) = self.material.indices(lambda_nm, T::zero())?;
+        Ok(Surface {
+            exterior: Uniaxial::isotropic_unchecked(cx::real(self.ext)),
+            crystal: Uniaxial {
+                eta_o,
+                eta_e,
+                axis: self.axis / self.axis.dot(&self.axis).sqrt(),
+            },
+        })
+    }
+}
+
+/// The lobe a path samples from the crystal surface of `q` at one wavelength per channel seen
+/// from `wi`, chosen with the uniform number `u` among the components whose bits `components`
+/// sets (0 reflection, 1 ordinary, 2 extraordinary refraction), as Mitsuba's sample
+/// ([`choice::sample`]). A material whose indices do not depend on the wavelength is solved
+/// once.
+pub fn sample_exact<T: Real, const C: usize>(
+    q: &ExactCrystal<T>,
+    wavelengths: &[T; C],
+    wi: Vector3<T>,
+    u: T,
+    transport: Transport,
+    components: u32,
+) -> Result<Sampled<T, C>> {
+    let mut slots: [Slots<CRYSTAL_SLOTS, T>; C] = [[None; CRYSTAL_SLOTS]; C];
+    for (c, &lambda_nm) in wavelengths.iter().enumerate() {
+        let surface = q.surface_at(lambda_nm)?;
+        if c > 0 && !q.material.is_dispersive() {
+            slots[c] = slots[c - 1];
+            continue;
+        }
+        fill_crystal_slots(&surface, wi, transport, &mut slots[c])?;
+        if q.output == Output::Intensity {
+            for lobe in slots[c].iter_mut().flatten() {
+                let m00 = lobe.mueller[(0, 0)];
+                lobe.mueller = Matrix4::from_fn(|i, j| if i + j == 0 { m00 } else { T::zero() });
+            }
+        }
+    }
+    Ok(choice::sample(
+        &slots,
+        |slot| components & (1 << crystal_component(slot)) != 0,
+        crystal_component,
+        u,
+    ))
 }

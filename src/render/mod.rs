@@ -19,7 +19,7 @@ pub mod stack;
 pub mod tangents;
 pub mod thin;
 
-use crate::real::{Mask, Real};
+use crate::real::{Mask, Real, Select};
 use nalgebra::{Matrix4, Vector3};
 
 /// Mitsuba's transport modes.
@@ -96,6 +96,25 @@ impl<T: Real> PathLobe<T> {
         PathLobe {
             exists: self.exists & exists,
             ..self
+        }
+    }
+}
+
+/// The lobe of `a` or of `b` per lane (both of one component: a slot's lobes in two outcomes
+/// of a decision about the lanes).
+impl<T: Real> Select<T::Mask> for PathLobe<T> {
+    fn select(m: T::Mask, a: Self, b: Self) -> Self {
+        debug_assert_eq!(a.component, b.component);
+        PathLobe {
+            component: a.component,
+            wo: Select::select(m, a.wo, b.wo),
+            in_stokes_x: Select::select(m, a.in_stokes_x, b.in_stokes_x),
+            out_stokes_x: Select::select(m, a.out_stokes_x, b.out_stokes_x),
+            mueller: Select::select(m, a.mueller, b.mueller),
+            weight: T::select(m, a.weight, b.weight),
+            power: T::select(m, a.power, b.power),
+            eta: T::select(m, a.eta, b.eta),
+            exists: Select::select(m, a.exists, b.exists),
         }
     }
 }

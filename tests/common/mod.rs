@@ -74,3 +74,68 @@ pub fn random_plate(
         thickness_nm: 10f64.powf(rng.range(log10_nm.0, log10_nm.1)),
     }
 }
+
+/// A sample of the generic code run on `f64` in the layout of a recorded program's outputs
+/// (`bridge::SampleOutput`, without the failure mask): a query of fewer than four channels
+/// repeats its last.
+pub fn sample_outputs<const C: usize>(
+    s: &birefringent::render::choice::Sampled<f64, C>,
+) -> Vec<f64> {
+    let mut out = vec![
+        f64::from(u8::from(s.valid)),
+        s.slot,
+        s.component,
+        s.pdf,
+        s.eta,
+    ];
+    out.extend(s.wo.iter());
+    for ch in 0..4 {
+        let ch = ch.min(C - 1);
+        out.extend(s.in_x[ch].iter().chain(s.out_x[ch].iter()));
+        out.extend(s.value[ch].transpose().iter());
+    }
+    out
+}
+
+/// The largest difference between a recorded program's outputs `got` and the host's `want`
+/// ([`sample_outputs`]) relative to `1 +` their size, over the outputs of the first `channels`
+/// channels (the others repeat the last); panics with `context` beyond `tol`.
+pub fn compare_outputs(
+    got: &[f64],
+    want: &[f64],
+    channels: usize,
+    tol: f64,
+    context: &dyn std::fmt::Debug,
+) -> f64 {
+    use birefringent::ffi::bridge::SampleOutput;
+    let per = SampleOutput::PerChannel.repr as usize;
+    let first = SampleOutput::Channel0.repr as usize;
+    let mut worst = 0.0f64;
+    for (k, (g, w)) in got.iter().zip(want).enumerate() {
+        if k.checked_sub(first).is_some_and(|j| j / per >= channels) {
+            continue;
+        }
+        let e = (g - w).abs() / (1.0 + g.abs().max(w.abs()));
+        assert!(e <= tol, "output {k}: {g} vs {w}\n{context:?}");
+        worst = worst.max(e);
+    }
+    worst
+}
+
+/// Panics with `context` unless every value `program` computes on `inputs` is finite, those of
+/// the outcomes its `select`s discard included (a NaN there would poison Dr.Jit's derivatives:
+/// `0 · NaN`).
+pub fn assert_every_value_finite(
+    program: &birefringent::record::Program,
+    inputs: &[f64],
+    context: &dyn std::fmt::Debug,
+) {
+    let every = birefringent::record::Program {
+        outputs: (0..program.instrs.len() as u32).collect(),
+        ..program.clone()
+    };
+    if let Some(k) = every.run(inputs).iter().position(|x| !x.is_finite()) {
+        let i = program.instrs[k];
+        panic!("value {k} ({i:?}) is not finite\n{context:?}");
+    }
+}

@@ -4,10 +4,12 @@
 //! Dr.Jit's derivatives). The inputs and outputs of each program are the bridge's enums
 //! (`PlateInput`, `SampleOutput`): the one contract with the shim. One module per plugin.
 
+mod crystal;
 mod layer;
 mod plate;
 mod stack;
 
+pub use crystal::record_crystal;
 pub use plate::record_plate;
 pub use stack::record_stack;
 
