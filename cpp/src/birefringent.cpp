@@ -97,6 +97,7 @@ and 5).
         'optic_axis_space': 'world'
 */
 #include "plugins.h"
+#include "recorded.h"
 #include "differentiable.h"
 #include "last_valid.h"
 
@@ -200,6 +201,7 @@ private:
         m_flags = m_components[0] | m_components[1] | m_components[2];
         check_at_load(axis);
         m_diff.commit(material, axis);
+        m_programs.clear();
     }
 
 public:
@@ -214,7 +216,10 @@ public:
                 components |= 1u << k;
         if (!components || shim::none_active(active))
             return { dr::zeros<BSDFSample3f>(), dr::zeros<Spectrum>() };
-        return query(si, ctx.mode, components, sample1, active);
+        if constexpr (dr::is_jit_v<Float>)
+            return replayed(si, ctx.mode, components, sample1, active);
+        else
+            return query(si, ctx.mode, components, sample1, active);
     }
 
     Spectrum eval(const BSDFContext &, const SurfaceInteraction3f &, const Vector3f &,
@@ -280,7 +285,7 @@ private:
     std::pair<BSDFSample3f, Spectrum> query(const SurfaceInteraction3f &si, TransportMode mode,
                                             uint32_t components, const Float &sample1,
                                             const Mask &active) const {
-        shim::require_evaluated_mode<Float>(ClassName, "no query of this plugin yet");
+        shim::require_evaluated_mode<Float>(ClassName, "every query");
         shim::HostInputs<Float> in;
         const shim::PathColumns path = shim::add_path_inputs<Float, Spectrum>(in, si, sample1, active);
         size_t k_axis = 0;
@@ -350,6 +355,69 @@ private:
         return answers.sample();
     }
 
+    /// The key of a program: the transport mode, the enabled components, and which parameters
+    /// are inputs (the axis: carrying derivatives or given in world space; the indices; the
+    /// extinctions).
+    using ProgramKey = std::tuple<bool, uint32_t, bool, bool, bool>;
+
+    /// The sample of the program of this setting, replayed on the lanes of `si` (recorded.h):
+    /// every query of the JIT variants, at each sampled wavelength (spectral variants) or at the
+    /// variant's wavelength (RGB, mono).
+    std::pair<BSDFSample3f, Spectrum> replayed(const SurfaceInteraction3f &si,
+                                               TransportMode mode, uint32_t components,
+                                               const Float &sample1, const Mask &active) const {
+        using In = bfr::CrystalInput;
+        using Answer = shim::Replayed<Float, Spectrum>;
+        constexpr size_t Channels = is_spectral_v<Spectrum> ? Answer::Channels : 1;
+        bool radiance = mode == TransportMode::Radiance;
+        Float eta_o = m_diff.eta_o(), eta_e = m_diff.eta_e(), kappa_o = m_diff.kappa_o(),
+              kappa_e = m_diff.kappa_e();
+        // The axis in the shading frame: in world space, it moves with the frame.
+        Vector3f axis = m_diff.optic_axis();
+        if (m_axis_in_world)
+            axis = si.to_local(axis);
+        bool axis_input = m_axis_in_world || dr::grad_enabled(axis);
+        bool indices_input = !m_diff.material.named && dr::grad_enabled(eta_o, eta_e);
+        bool kappas_input = dr::grad_enabled(kappa_o, kappa_e);
+        ProgramKey key{ radiance, components, axis_input, indices_input, kappas_input };
+        const bfr::Program &program = m_programs.get(key, [&] {
+            const ScalarVector3f &a = m_diff.axis;
+            bfr::CrystalRecipe recipe{ 0,
+                                       radiance ? bfr::Transport::Radiance
+                                                : bfr::Transport::Importance,
+                                       components,
+                                       (uint32_t) Channels,
+                                       !is_polarized_v<Spectrum>,
+                                       m_ext_ior,
+                                       { a.x(), a.y(), a.z() },
+                                       axis_input,
+                                       indices_input,
+                                       kappas_input };
+            return shim::core_call(ClassName, [&] { return bfr::record_crystal(*m_material, recipe); });
+        });
+        std::vector<Float> x((size_t) In::Wavelength0 + Channels, Float(0.f));
+        auto set = [&](In k, const Float &v) { x[(size_t) k] = v; };
+        set(In::WiX, si.wi.x());
+        set(In::WiY, si.wi.y());
+        set(In::WiZ, si.wi.z());
+        set(In::Sample, sample1);
+        set(In::AxisX, axis.x());
+        set(In::AxisY, axis.y());
+        set(In::AxisZ, axis.z());
+        set(In::EtaO, eta_o);
+        set(In::EtaE, eta_e);
+        set(In::KappaO, kappa_o);
+        set(In::KappaE, kappa_e);
+        for (size_t c = 0; c < Channels; ++c) {
+            if constexpr (is_spectral_v<Spectrum>)
+                x[(size_t) In::Wavelength0 + c] = si.wavelengths[c];
+            else
+                x[(size_t) In::Wavelength0 + c] = Float((float) m_wavelength);
+        }
+        shim::Replay<Float> r(program, x);
+        return Answer::sample(r, si.wi, radiance, false, m_types, 3, active);
+    }
+
     /// The inputs of a query that carry gradients: the handles of the scalar parameters, the
     /// optic axis in the shading frame (`axis`: with the frame's gradients when given in world
     /// space), si.wi.
@@ -377,6 +445,8 @@ private:
     BSDFFlags m_types[(size_t) bfr::Bounds::CrystalComponents];
     mutable std::atomic<bool> m_warned { false };
     std::unique_ptr<shim::Snapshot<Float, Spectrum>> m_valid;  ///< last valid state
+    /// The programs of the JIT variants, by ProgramKey.
+    mutable shim::Programs<ProgramKey> m_programs;
 
     MI_TRAVERSE_CB(Base)
 };
