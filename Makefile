@@ -38,7 +38,8 @@
 #                 survives or no longer applies (tools/mutants.py; MUTANTS=id,id runs only those)
 #   make bench    make setup, then the core benchmark on one core (taskset -c 0) and its plot:
 #                 bench/out/core.json, bench/out/core_error_vs_time.png (several minutes), then
-#                 make bench-scenes, make bench-stack, make bench-jit and make bench-gradients
+#                 make bench-scenes, make bench-stack, make bench-jit, make bench-kernels and
+#                 make bench-gradients
 #   make bench-stack  layered stacks (examples/bench_stack.rs, one core): a 4-layer stack against
 #                 one plate at one wavelength and over XYZ (issue goals: at most 4x each), and the
 #                 channel integration's colour error on BENCH_STACKS random stacks against dense
@@ -46,6 +47,11 @@
 #   make bench-jit  the plugins in the llvm variants (evaluated mode): render time against
 #                 Mitsuba's dielectric/thindielectric and against the scalar variants, peak
 #                 memory; bench/out/jit.json and bench/out/jit.png
+#   make bench-kernels  the plugins in Mitsuba's default mode (their programs replayed in the
+#                 kernel) against Mitsuba's own plugins: six quartz plates, a bouncing calcite and
+#                 glass sphere; render time ratios, first render with an empty and a warm kernel
+#                 cache, peak memory; bench/out/kernels.json and bench/out/kernels.png
+#   make bench-cuda  the same in the cuda_ad variants (a machine with an NVIDIA GPU)
 #   make bench-gradients  gradient renders of the photoelastic disk (llvm_ad_spectral_polarized):
 #                 time and peak memory of a primal, a forward- and a reverse-mode gradient
 #                 render; bench/out/gradients.json
@@ -90,7 +96,7 @@ PLUGIN_BUILT := target/release/libmitsuba_birefringent.so
 # site-packages of .venv/ (evaluated when used: the venv may not exist yet when make starts)
 SITE = $(shell $(VPY) -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')
 
-.PHONY: help setup build venv llvm plugin plugin-lib render gallery test test-rust test-python mutants fuzz fuzz-ci bench bench-scenes bench-overhead bench-jit bench-variants bench-gradients bench-stack fmt lint clean distclean
+.PHONY: help setup build venv llvm plugin plugin-lib render gallery test test-rust test-python mutants fuzz fuzz-ci bench bench-scenes bench-overhead bench-jit bench-variants bench-kernels bench-cuda bench-gradients bench-stack fmt lint clean distclean
 
 help:
 	@sed -n '3,/^$$/s/^# \{0,1\}//p' $(firstword $(MAKEFILE_LIST))
@@ -256,6 +262,7 @@ bench: setup
 	$(MAKE) --no-print-directory bench-scenes
 	$(MAKE) --no-print-directory bench-stack
 	$(MAKE) --no-print-directory bench-jit
+	$(MAKE) --no-print-directory bench-kernels
 	$(MAKE) --no-print-directory bench-gradients
 
 # examples/bench_stack.rs: interleaved timings of stacks against plates, and the validation of
@@ -273,6 +280,17 @@ bench-stack: setup
 bench-jit: setup
 	@mkdir -p $(BENCH_OUT)
 	$(VPY) bench/jit.py --out $(BENCH_OUT)
+
+# bench/kernels.py: ours and Mitsuba's plugins both in Mitsuba's default (symbolic) mode; each
+# configuration in processes of its own (kernel cache cold, then warm), the time ratios from
+# interleaved rounds in one process. bench-cuda: the same rows in the cuda_ad variants.
+bench-kernels: setup
+	@mkdir -p $(BENCH_OUT)
+	$(VPY) bench/kernels.py --out $(BENCH_OUT)
+
+bench-cuda: setup
+	@mkdir -p $(BENCH_OUT)
+	$(VPY) bench/kernels.py --backend cuda --out $(BENCH_OUT)
 
 # bench/gradients.py: a primal, forward- and reverse-mode gradient renders of the photoelastic
 # disk in llvm_ad_spectral_polarized (the plate's birefringence texture, its thickness, and a

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Gradient renders with the plugins (``make bench-gradients``, part of ``make bench``): time and
 peak memory of a primal render, a forward-mode and a reverse-mode gradient render of the
-photoelastic disk (scenes/photoelastic_disk.py) in llvm_ad_spectral_polarized, evaluated mode.
+photoelastic disk (scenes/photoelastic_disk.py) in llvm_ad_spectral_polarized, in Mitsuba's
+default (symbolic) mode: the plate's derivatives are Dr.Jit's AD through its replayed program.
 
     .venv/bin/python bench/gradients.py [--out bench/out] [--repeats N] [--size 128] [--spp 8]
 
@@ -10,7 +11,9 @@ texture (its bitmap data: what the inverse example fits), its `thickness` (a flo
 texture), and, for comparison, a parameter of Mitsuba's own `retarder` behind the disk
 (`qwp_out.bsdf.delta`: Mitsuba's AD alone, the plate's queries asking for no derivative).
 A gradient render is `mi.render` with the parameter's gradient enabled, then `dr.backward` of
-the image's mean (reverse) or `dr.forward` from the parameter (forward), evaluated.
+the image's mean (reverse) or `dr.forward` from the parameter (forward), evaluated. With the
+gradient enabled the parameter is an input of the plate's program instead of a constant
+(docs/gradients.md section 2): its own kernels, compiled in the first round.
 
 1. **Time.** One process renders every configuration once (kernel compilation), then
    ``repeats`` interleaved rounds; the figures are medians of the process's CPU time
@@ -68,7 +71,7 @@ def load(size: int, spp: int):
 
 
 def run_one(scene, params, key, mode, spp: int) -> None:
-    """One render (and gradient), evaluated."""
+    """One render (and gradient), evaluated (the result read back)."""
     import drjit as dr
     import mitsuba as mi
 
@@ -89,19 +92,16 @@ def run_one(scene, params, key, mode, spp: int) -> None:
 
 
 def time_all(size: int, spp: int, repeats: int) -> dict:
-    from mitsuba_birefringent import evaluated_mode
-
     scene, params = load(size, spp)
     times = {name: {"cpu": [], "wall": []} for name, _, _ in RUNS}
-    with evaluated_mode():
-        for _, key, mode in RUNS:
+    for _, key, mode in RUNS:
+        run_one(scene, params, key, mode, spp)
+    for _ in range(repeats):
+        for name, key, mode in RUNS:
+            c, w = time.process_time(), time.perf_counter()
             run_one(scene, params, key, mode, spp)
-        for _ in range(repeats):
-            for name, key, mode in RUNS:
-                c, w = time.process_time(), time.perf_counter()
-                run_one(scene, params, key, mode, spp)
-                times[name]["cpu"].append(time.process_time() - c)
-                times[name]["wall"].append(time.perf_counter() - w)
+            times[name]["cpu"].append(time.process_time() - c)
+            times[name]["wall"].append(time.perf_counter() - w)
     return times
 
 
@@ -118,18 +118,15 @@ def peak_memory(index: int, size: int, spp: int) -> None:
     its resident set during two renders over the resident set before them (KiB)."""
     import gc
 
-    from mitsuba_birefringent import evaluated_mode
-
     scene, params = load(size, spp)
     _, key, mode = RUNS[index]
-    with evaluated_mode():
+    run_one(scene, params, key, mode, spp)
+    gc.collect()
+    before = status_kib("VmRSS")
+    pathlib.Path("/proc/self/clear_refs").write_text("5")  # resets VmHWM
+    for _ in range(2):
         run_one(scene, params, key, mode, spp)
-        gc.collect()
-        before = status_kib("VmRSS")
-        pathlib.Path("/proc/self/clear_refs").write_text("5")  # resets VmHWM
-        for _ in range(2):
-            run_one(scene, params, key, mode, spp)
-        peak = status_kib("VmHWM")
+    peak = status_kib("VmHWM")
     print(RESULT + json.dumps(max(0, peak - before)))
 
 
@@ -170,7 +167,7 @@ def main() -> None:
               "times": times, "seconds": time.perf_counter() - start}
     a.out.mkdir(parents=True, exist_ok=True)
     (a.out / "gradients.json").write_text(json.dumps(result, indent=1))
-    print(f"photoelastic disk, {a.size}x{a.size}, {a.spp} spp, {VARIANT}, evaluated mode; "
+    print(f"photoelastic disk, {a.size}x{a.size}, {a.spp} spp, {VARIANT}, default (symbolic) mode; "
           f"load {load_before[0]:.1f} -> {load_after[0]:.1f} on {os.cpu_count()} cpus")
     print(f"{'run':42s} {'cpu s':>7s} {'x primal':>9s} {'wall s':>7s} {'x primal':>9s} "
           f"{'peak MiB':>9s}")

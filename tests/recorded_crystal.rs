@@ -103,7 +103,14 @@ fn random_lane(rng: &mut Rng, materials: &mut Materials) -> Lane {
         _ => materials.add_constant(eta.0, eta.1, eta.2, eta.3),
     }
     .unwrap();
-    let inputs = (rng.chance(0.5), rng.chance(0.5), rng.chance(0.5));
+    // Extinction is an input only of a crystal that can absorb (an isotropic one): a
+    // birefringent crystal's kappa has no derivative and is refused (below).
+    let isotropic = matches!(kind, Kind::Isotropic | Kind::Opaque);
+    let inputs = (
+        rng.chance(0.5),
+        rng.chance(0.5),
+        isotropic && rng.chance(0.5),
+    );
     // A texture gives some lanes other values than the material's: an isotropic material
     // birefringent indices and a birefringent one equal indices, a clear material absorption
     // and an absorbing one none (what the program cannot know while recording).
@@ -438,7 +445,7 @@ fn decisions_known_from_the_recipe_are_made_while_recording() {
             optic_axis: [0.3, 0.2, 0.9],
             axis_is_input: inputs,
             indices_are_inputs: inputs,
-            kappas_are_inputs: inputs,
+            kappas_are_inputs: inputs && material != calcite && material != birefringent,
         };
         record_crystal(&materials, &recipe).unwrap().operations()
     };
@@ -453,4 +460,32 @@ fn decisions_known_from_the_recipe_are_made_while_recording() {
     assert!(4 * glass < crystal && 4 * metal < crystal);
     assert!(calcite_4 > 3 * calcite && crystal < calcite);
     assert!(glass_inputs > crystal_inputs.min(crystal));
+}
+
+/// Extinction carrying derivatives on a birefringent crystal (which cannot absorb) is refused
+/// when its program is recorded, naming kappa_o and the reason, instead of a derivative of 0.
+#[test]
+fn birefringent_extinction_inputs_are_refused() {
+    let mut materials = new_materials();
+    let calcite = materials.add_named("calcite", 0.0, 0.0).unwrap();
+    let glass = materials.add_constant(1.5, 1.5, 0.0, 0.0).unwrap();
+    let recipe = |material: u32| CrystalRecipe {
+        material,
+        transport: T::Radiance,
+        components: 7,
+        channels: 4,
+        intensity_only: false,
+        ext_ior: 1.0,
+        optic_axis: [0.0, 0.0, 1.0],
+        axis_is_input: false,
+        indices_are_inputs: false,
+        kappas_are_inputs: true,
+    };
+    let refused = record_crystal(&materials, &recipe(calcite)).err().unwrap();
+    let message = refused.to_string();
+    assert!(
+        message.contains("kappa_o") && message.contains("cannot absorb"),
+        "{message}"
+    );
+    assert!(record_crystal(&materials, &recipe(glass)).is_ok());
 }

@@ -301,12 +301,7 @@ private:
         const size_t waves = is_spectral_v<Spectrum> ? path.waves : 1;
         Answers answers;
         size_t n = in.width();
-        answers.allocate(n, tangent_inputs(si, axis));
-        const shim::TangentInputs<Float> &tangents = answers.tangents();
-        if (!tangents.empty())
-            shim::core_call(ClassName, [&] {
-                bfr::crystal_tangents_available(*m_material, tangents.request());
-            });
+        answers.allocate(n);
         in.read();
 
         bool radiance = mode == TransportMode::Radiance;
@@ -332,21 +327,12 @@ private:
                                      b.constant(AxisY, m_diff.axis.y()).slice(),
                                      b.constant(AxisZ, m_diff.axis.z()).slice() };
             bfr::Samples s = b.samples(lanes.count, waves, is_polarized_v<Spectrum>);
-            bfr::Status rc;
-            if (tangents.empty()) {
-                rc = bfr::sample_crystal(*m_material, components, lanes, s);
-            } else {
-                bfr::Tangents t = shim::tangent_columns(b, tangents.request(), tangents.columns(),
-                                                        lanes.count, waves, is_polarized_v<Spectrum>);
-                rc = bfr::sample_crystal_tangents(*m_material, components, lanes, t, s);
-            }
+            bfr::Status rc = bfr::sample_crystal(*m_material, components, lanes, s);
             for (size_t j = 0; j < lanes.count; ++j) {
                 size_t i = begin + j;
                 Vec3d wi(in.floats(path.wi[0]).at(i), in.floats(path.wi[1]).at(i),
                          in.floats(path.wi[2]).at(i));
                 answers.write(b, lanes.count, j, waves, wi, radiance, std::nullopt, m_types, i);
-                if (!tangents.empty())
-                    answers.write_tangents(b, lanes.count, j, waves, i);
             }
             return rc == bfr::Status::Ok ? std::string() : shim::core_message(rc, s.message);
         });
@@ -416,23 +402,6 @@ private:
         }
         shim::Replay<Float> r(program, x);
         return Answer::sample(r, si.wi, radiance, false, m_types, 3, active);
-    }
-
-    /// The inputs of a query that carry gradients: the handles of the scalar parameters, the
-    /// optic axis in the shading frame (`axis`: with the frame's gradients when given in world
-    /// space), si.wi.
-    shim::TangentInputs<Float> tangent_inputs(const SurfaceInteraction3f &si,
-                                              const Vector3f &axis) const {
-        shim::TangentInputs<Float> t;
-        if (!m_diff.material.named) {
-            t.add(bfr::Tangent::EtaO, m_diff.eta_o());
-            t.add(bfr::Tangent::EtaE, m_diff.eta_e());
-        }
-        t.add(bfr::Tangent::KappaO, m_diff.kappa_o());
-        t.add(bfr::Tangent::KappaE, m_diff.kappa_e());
-        t.add(bfr::Tangent::OpticAxis, axis);
-        t.add(bfr::Tangent::Wi, si.wi);
-        return t;
     }
 
     /// eta_o, eta_e, kappa_o, kappa_e and optic_axis (differentiable in the JIT variants).

@@ -14,8 +14,10 @@ Birefringent stack (:monosp:`birefringentstack`)
      ``kappa_o``, ``kappa_e``, ``optic_axis``, ``thickness`` and ``thickness_scale``,
      ``birefringence`` and ``birefringence_scale``, ``axis_angle`` (textures where the plate takes
      them). A layer may not set ``ext_ior``, ``exit_ior``, ``filter_bandwidth``, ``channel`` or
-     ``absorbing_exit``: those are the stack's. Exposed as ``layer_0``, ``layer_1``, ...
-   - |exposed|
+     ``absorbing_exit``: those are the stack's. Exposed as ``layer_0``, ``layer_1``, ...; in the
+     JIT variants each layer's parameters that a plate has differentiable are differentiable
+     (``layer_1.thickness.value``, ...).
+   - |exposed|, |differentiable|
 
  * - ext_ior
    - |float| or |string|
@@ -336,6 +338,11 @@ private:
         std::array<std::array<double, 3>, MaxLayers> scales;
         for (size_t k = 0; k < n_layers; ++k) {
             Layer l = m_sources[k]->layer();
+            auto value = [&](const Texture *t) { return t ? t->eval_1(si, active) : Float(0.f); };
+            shim::refuse_gradients(ClassName, *m_spectrum, si.wi, value(l.thickness),
+                                   value(l.birefringence), value(l.axis_angle), l.diff->eta_o(),
+                                   l.diff->eta_e(), l.diff->kappa_o(), l.diff->kappa_e(),
+                                   l.diff->optic_axis());
             scalars[k] = { scalar(in, l.thickness, 0.0, si, active),
                            scalar(in, l.birefringence, 0.0, si, active),
                            scalar(in, l.axis_angle, 0.0, si, active) };

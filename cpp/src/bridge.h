@@ -61,6 +61,21 @@ void require_evaluated_mode(const char *ClassName, const char *recorded_where) {
     }
 }
 
+/// Throws, in a JIT variant, if any of `inputs` carries derivatives: a query that calls the
+/// core on the host (`spectrum`: a band or colour channels) is outside Dr.Jit's graph, and a
+/// gradient through it would silently be 0. The core's reason names what to use instead.
+template <typename... Ts>
+void refuse_gradients(const char *ClassName, const bfr::PlateSpectrum &spectrum,
+                      const Ts &...inputs) {
+    if constexpr ((dr::is_diff_v<Ts> || ...)) {
+        if ((dr::grad_enabled(inputs) || ...)) {
+            std::string reason(spectrum.gradients_refused());
+            if (!reason.empty())
+                Throw("%s", reason);
+        }
+    }
+}
+
 /// True if no lane is active: a scalar variant's inactive query (a JIT variant does not look,
 /// which would cost a synchronisation; the core skips inactive lanes).
 template <typename Mask> bool none_active(const Mask &active) {
@@ -274,11 +289,6 @@ template <size_t Cap, size_t Inputs = MaxInputs> struct ChunkBuffers {
     std::array<std::array<double, Cap * MaxChannels>, 3> in_x, out_x;
     std::array<std::array<double, Cap * MaxChannels>, 16> value;
 
-    /// Output columns of derivatives (tangents.h), sized on the first query that asks for
-    /// them: `columns` per lane, per channel for the weight.
-    std::array<std::vector<double>, 3> d_wo;
-    std::array<std::vector<double>, 16> d_value;
-
     /// Copies `c` for lanes [begin, end) into input column `k` (one value if `c` has one),
     /// applying `f` to each value.
     template <typename F = double (*)(double)>
@@ -336,26 +346,6 @@ template <size_t Cap, size_t Inputs = MaxInputs> struct ChunkBuffers {
         return s;
     }
 };
-
-/// The core's derivative output view for `n` lanes of `channels` channels and the request
-/// `inputs` (`columns` columns); `polarized`: the whole Mueller matrix, else its (0, 0) entry.
-template <size_t Cap>
-bfr::Tangents tangent_columns(ChunkBuffers<Cap> &b, rust::Slice<const bfr::Tangent> inputs,
-                              size_t columns, size_t n, size_t channels, bool polarized) {
-    bfr::Tangents t{};
-    t.inputs = inputs;
-    for (size_t k = 0; k < 3; ++k) {
-        if (b.d_wo[k].size() < columns * Cap)
-            b.d_wo[k].resize(columns * Cap);
-        t.wo[k] = { b.d_wo[k].data(), columns * n };
-    }
-    for (size_t e = 0; e < (polarized ? 16 : 1); ++e) {
-        if (b.d_value[e].size() < columns * Cap * MaxChannels)
-            b.d_value[e].resize(columns * Cap * MaxChannels);
-        t.value[e] = { b.d_value[e].data(), columns * channels * n };
-    }
-    return t;
-}
 
 /** Buffers for one chunk: on the stack in the scalar variants; in the JIT ones, one set per
  * thread of Dr.Jit's pool, allocated on its first chunk and reused by every later one (a chunk

@@ -21,7 +21,6 @@
 #include <vector>
 
 #include "bridge.h"
-#include "tangents.h"
 
 NAMESPACE_BEGIN(mitsuba)
 NAMESPACE_BEGIN(shim)
@@ -40,9 +39,8 @@ public:
     using Vec3d = mitsuba::Vector<double, 3>;
     using Mueller4d = mitsuba::MuellerMatrix<double>;
 
-    /// Allocates the answers of `n` lanes (before the inputs are read), with the derivative
-    /// columns `tangents` asks for; the answers' gradients are then attached to its inputs.
-    void allocate(size_t n, TangentInputs<Float> tangents = {}) {
+    /// Allocates the answers of `n` lanes (before the inputs are read).
+    void allocate(size_t n) {
         for (auto *o : { &m_pdf, &m_eta, &m_wo[0], &m_wo[1], &m_wo[2] })
             o->allocate(n);
         m_component.allocate(n);
@@ -50,18 +48,6 @@ public:
         for (auto &row : m_value)
             for (auto &o : row)
                 o.allocate(n);
-        m_tangents = std::move(tangents);
-        size_t columns = m_tangents.columns();
-        if (columns == 0)
-            return;  // the plain query: nothing more
-        m_d_wo.resize(3 * columns);
-        m_d_value.resize(Entries * Channels * columns);
-        for (auto &o : m_d_wo)
-            o.allocate(n);
-        for (auto &o : m_d_value)
-            o.allocate(n);
-        m_used_wo.reset(new std::atomic<bool>[columns]());
-        m_used_value.reset(new std::atomic<bool>[columns]());
     }
 
     /** Writes lane `j` of a chunk of `n` lanes with `core_channels` channels as lane `i`. `wi`:
@@ -100,31 +86,11 @@ public:
         }
     }
 
-    /// The inputs carrying gradients (the core's request).
-    const TangentInputs<Float> &tangents() const { return m_tangents; }
-
-    /** Writes the derivative columns of lane `j` of a chunk of `n` lanes with `core_channels`
-     * channels (the core's `tangent_columns`) as lane `i`. */
-    template <size_t Cap>
-    void write_tangents(const ChunkBuffers<Cap> &b, size_t n, size_t j, size_t core_channels,
-                        size_t i) {
-        for (size_t k = 0; k < m_tangents.columns(); ++k) {
-            for (size_t c = 0; c < 3; ++c)
-                store(m_d_wo[3 * k + c], m_used_wo[k], i, b.d_wo[c][k * n + j]);
-            for (size_t ch = 0; ch < Channels; ++ch) {
-                size_t src = (k * core_channels + (core_channels == 1 ? 0 : ch)) * n + j;
-                for (size_t e = 0; e < Entries; ++e)
-                    store(d_value(k, e, ch), m_used_value[k], i, b.d_value[e][src]);
-            }
-        }
-    }
-
     /// The sampled lobes as Mitsuba's sample and weight.
     std::pair<BSDFSample3f, Spectrum> sample() const {
         BSDFSample3f bs = dr::zeros<BSDFSample3f>();
         for (size_t c = 0; c < 3; ++c)
-            bs.wo[c] = attached(m_wo[c].get(), [&](size_t k) { return m_d_wo[3 * k + c].get(); },
-                                m_used_wo);
+            bs.wo[c] = m_wo[c].get();
         bs.pdf = m_pdf.get();
         bs.eta = m_eta.get();
         bs.sampled_component = m_component.get();
@@ -149,42 +115,8 @@ public:
     }
 
 private:
-    using Flags = std::unique_ptr<std::atomic<bool>[]>;
-
-    /// Entry `e` of channel `ch` of the weight, with its gradients attached.
-    Float value(size_t e, size_t ch) const {
-        return attached(m_value[e][ch].get(), [&](size_t k) { return d_value(k, e, ch).get(); },
-                        m_used_value);
-    }
-
-    /// `value` with the derivative columns `column(k)` attached to the query's inputs, except
-    /// columns that are zero in every lane (`used[k]` false), which are left out: an input that
-    /// does not move a quantity (the thickness does not move `wo`) adds no term to the graph,
-    /// and the quantity stays detached for the integrator (e.g. its frame rotations at exactly
-    /// normal incidence, where Mitsuba's `unit_angle` differentiates `sqrt` at 0).
-    template <typename Column>
-    Float attached(const Float &value, Column &&column, const Flags &used) const {
-        if (m_tangents.empty())
-            return value;
-        return m_tangents.attach(value, column,
-                                 [&](size_t k) { return used[k].load(std::memory_order_relaxed); });
-    }
-
-    /// Writes `x` as lane `i` of `o`; `used` records that a column has a non-zero entry (chunks
-    /// on several threads set it, relaxed: only true is ever stored).
-    static void store(HostOutput<Float> &o, std::atomic<bool> &used, size_t i, double x) {
-        float f = (float) x;
-        o.data()[i] = f;
-        if (f != 0.f && !used.load(std::memory_order_relaxed))
-            used.store(true, std::memory_order_relaxed);
-    }
-
-    HostOutput<Float> &d_value(size_t k, size_t e, size_t ch) {
-        return m_d_value[(k * Entries + e) * Channels + ch];
-    }
-    const HostOutput<Float> &d_value(size_t k, size_t e, size_t ch) const {
-        return m_d_value[(k * Entries + e) * Channels + ch];
-    }
+    /// Entry `e` of channel `ch` of the weight.
+    Float value(size_t e, size_t ch) const { return m_value[e][ch].get(); }
 
     /// Lane `i` samples nothing.
     void zero(size_t i) {
@@ -194,9 +126,6 @@ private:
         m_type.data()[i] = 0;
         for (auto &row : m_value)
             for (auto &o : row)
-                o.data()[i] = 0.f;
-        for (auto *d : { &m_d_wo, &m_d_value })
-            for (auto &o : *d)
                 o.data()[i] = 0.f;
     }
 
@@ -239,12 +168,6 @@ private:
     HostOutput<Float> m_pdf, m_eta, m_wo[3];
     HostOutput<UInt32> m_component, m_type;
     HostOutput<Float> m_value[Entries][Channels];
-    /// The inputs carrying gradients and the derivative columns: `d wo` of column k at
-    /// 3 k + c, `d value` by `d_value`.
-    TangentInputs<Float> m_tangents;
-    std::vector<HostOutput<Float>> m_d_wo, m_d_value;
-    /// Per column: whether any lane's derivative of `wo` / of the weight is non-zero.
-    Flags m_used_wo, m_used_value;
 };
 
 NAMESPACE_END(shim)

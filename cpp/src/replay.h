@@ -35,6 +35,7 @@ public:
     /// Runs `program` on `inputs` (one array per program input, in its input order).
     Replay(const bfr::Program &program, const std::vector<Float> &inputs) {
         std::vector<Value> wide(inputs.begin(), inputs.end());
+        broadcast_differentiable(wide);
         rust::Slice<const bfr::Instr> code = program.instructions();
         m_number.resize(code.size());
         m_mask.resize(code.size());
@@ -50,6 +51,22 @@ public:
     const Mask &mask(size_t k) const { return m_mask[m_outputs[k]]; }
 
 private:
+    /** A parameter (one value for every lane) that carries gradients, broadcast to the lanes
+     * once. Used as it is, each instruction reading it would be an edge of its own from one
+     * value to many, and Dr.Jit's reverse mode reduces the gradient of each such edge in a
+     * kernel of its own (measured: 48 reductions, each a kernel compiled anew, for one plate
+     * parameter); broadcast here, the gradient is reduced once. */
+    static void broadcast_differentiable(std::vector<Value> &inputs) {
+        if constexpr (dr::is_diff_v<Value>) {
+            size_t width = 1;
+            for (const Value &v : inputs)
+                width = std::max(width, dr::width(v));
+            for (Value &v : inputs)
+                if (width > 1 && dr::width(v) == 1 && dr::grad_enabled(v))
+                    v = v * dr::opaque<Value>(1.0, width);
+        }
+    }
+
     void step(const bfr::Instr &c, size_t i, const std::vector<Value> &inputs) {
         using Op = bfr::Op;
         const auto &n = m_number;

@@ -429,14 +429,12 @@ private:
         size_t k_biref = m_birefringence ? in.add(birefringence) : 0;
         size_t k_angle = m_axis_angle ? in.add(angle_deg) : 0;
         const size_t waves = path.waves;
+        shim::refuse_gradients(ClassName, *m_spectrum, si.wi, thickness, birefringence, angle_deg,
+                               m_diff.eta_o(), m_diff.eta_e(), m_diff.kappa_o(),
+                               m_diff.kappa_e(), m_diff.optic_axis());
         Answers answers;
         size_t n = in.width();
-        answers.allocate(n, tangent_inputs(si, thickness, birefringence, angle_deg));
-        const shim::TangentInputs<Float> &tangents = answers.tangents();
-        if (!tangents.empty())
-            shim::core_call(ClassName, [&] {
-                bfr::plate_tangents_available(*m_material, *m_spectrum, tangents.request());
-            });
+        answers.allocate(n);
         in.read();
 
         bool radiance = mode == TransportMode::Radiance;
@@ -467,14 +465,7 @@ private:
                                 [this](double x) { return m_birefringence_scale * x; }).slice()
                     : b.constant(Birefringence, 0.0).slice();
             bfr::Samples s = b.samples(lanes.count, channels, is_polarized_v<Spectrum>);
-            bfr::Status rc;
-            if (tangents.empty()) {
-                rc = bfr::sample_plate(*m_material, *m_spectrum, settings, lanes, s);
-            } else {
-                bfr::Tangents t = shim::tangent_columns(b, tangents.request(), tangents.columns(),
-                                                        lanes.count, channels, is_polarized_v<Spectrum>);
-                rc = bfr::sample_plate_tangents(*m_material, *m_spectrum, settings, lanes, t, s);
-            }
+            bfr::Status rc = bfr::sample_plate(*m_material, *m_spectrum, settings, lanes, s);
             for (size_t j = 0; j < lanes.count; ++j) {
                 size_t i = begin + j;
                 Vec3d wi(in.floats(path.wi[0]).at(i), in.floats(path.wi[1]).at(i),
@@ -483,8 +474,6 @@ private:
                 if (straight)
                     through = -wi;
                 answers.write(b, lanes.count, j, channels, wi, radiance, through, m_types, i);
-                if (!tangents.empty())
-                    answers.write_tangents(b, lanes.count, j, channels, i);
             }
             return rc == bfr::Status::Ok ? std::string() : shim::core_message(rc, s.message);
         });
@@ -564,28 +553,6 @@ private:
                 x[(size_t) In::Wavelength0 + c] = si.wavelengths[c];
         shim::Replay<Float> r(program, x);
         return Answer::sample(r, si.wi, radiance, straight, m_types, 2, active);
-    }
-
-    /// The inputs of a query that carry gradients (the texture values at the hit, the
-    /// handles of the scalar parameters, si.wi), in the core's units.
-    shim::TangentInputs<Float> tangent_inputs(const SurfaceInteraction3f &si,
-                                              const Float &thickness, const Float &birefringence,
-                                              const Float &angle_deg) const {
-        shim::TangentInputs<Float> t;
-        t.add(bfr::Tangent::Thickness, thickness, thickness_nm(1.0));
-        if (m_birefringence)
-            t.add(bfr::Tangent::Birefringence, birefringence, m_birefringence_scale);
-        if (m_axis_angle)
-            t.add(bfr::Tangent::AxisAngle, angle_deg);
-        if (!m_diff.material.named) {
-            t.add(bfr::Tangent::EtaO, m_diff.eta_o());
-            t.add(bfr::Tangent::EtaE, m_diff.eta_e());
-        }
-        t.add(bfr::Tangent::KappaO, m_diff.kappa_o());
-        t.add(bfr::Tangent::KappaE, m_diff.kappa_e());
-        t.add(bfr::Tangent::OpticAxis, m_diff.optic_axis());
-        t.add(bfr::Tangent::Wi, si.wi);
-        return t;
     }
 
     /// The optic axis `a` (the core rotates it by `axis_angle`).

@@ -3,15 +3,13 @@
 //! Nothing is allocated per lane here; panics are caught per lane.
 
 use super::bridge::{
-    Bounds, CrystalLanes, PlateCall, PlateLanes, Samples, Status, Tangents,
-    Transport as BridgeTransport,
+    Bounds, CrystalLanes, PlateCall, PlateLanes, Samples, Status, Transport as BridgeTransport,
 };
 use super::columns::{Column, Columns3, Wavelengths, MAX_CHANNELS};
-use super::guard::{guarded, non_finite, status};
+use super::guard::{guarded, status};
 use super::materials::Materials;
 use super::samples::Output;
 use super::spectrum::PlateSpectrum;
-use super::tangents::{crystal_inputs, plate_inputs, TangentOutput};
 use crate::error::{Error, Result};
 use crate::material::Material;
 use crate::optics::frame::rotated_about_normal;
@@ -22,7 +20,6 @@ use crate::render::choice::{choose, Choice};
 use crate::render::crystal::fill_crystal_slots;
 use crate::render::plate::{plate_lobes, PlateQuery, Spectrum, MAX_BANDS};
 use crate::render::slots::{crystal_component, plate_component, Slots, CRYSTAL_SLOTS, PLATE_SLOTS};
-use crate::render::tangents::{Columns, Input, Lane, Point};
 use crate::render::Transport;
 use crate::C64;
 use nalgebra::Vector3;
@@ -43,19 +40,7 @@ pub fn sample_plate(
     lanes: &PlateLanes,
     out: &mut Samples,
 ) -> Status {
-    plate_batch(materials, spectrum, call, lanes, None, out)
-}
-
-/// [`sample_plate`] with derivatives (see `bridge::sample_plate_tangents`).
-pub fn sample_plate_tangents(
-    materials: &Materials,
-    spectrum: &PlateSpectrum,
-    call: &PlateCall,
-    lanes: &PlateLanes,
-    tangents: &mut Tangents,
-    out: &mut Samples,
-) -> Status {
-    plate_batch(materials, spectrum, call, lanes, Some(tangents), out)
+    plate_batch(materials, spectrum, call, lanes, out)
 }
 
 /// Samples a crystal lobe in every lane (see `bridge::sample_crystal`).
@@ -65,18 +50,7 @@ pub fn sample_crystal(
     lanes: &CrystalLanes,
     out: &mut Samples,
 ) -> Status {
-    crystal_batch(materials, components, lanes, None, out)
-}
-
-/// [`sample_crystal`] with derivatives (see `bridge::sample_crystal_tangents`).
-pub fn sample_crystal_tangents(
-    materials: &Materials,
-    components: u32,
-    lanes: &CrystalLanes,
-    tangents: &mut Tangents,
-    out: &mut Samples,
-) -> Status {
-    crystal_batch(materials, components, lanes, Some(tangents), out)
+    crystal_batch(materials, components, lanes, out)
 }
 
 fn plate_batch(
@@ -84,42 +58,19 @@ fn plate_batch(
     spectrum: &PlateSpectrum,
     call: &PlateCall,
     lanes: &PlateLanes,
-    tangents: Option<&mut Tangents>,
     out: &mut Samples,
 ) -> Status {
     let run = || {
         let cols = PlateColumns::new(lanes)?;
         spectrum.check_wavelength_columns(cols.common.wavelengths.count())?;
         let channels = spectrum.channels(cols.common.wavelengths.count());
-        let full = !out.value[1].is_empty();
-        let mut derivatives = match tangents {
-            Some(t) => {
-                let inputs = plate_inputs(materials, spectrum, t.inputs)?;
-                Some(TangentOutput::new(t, inputs, lanes.count, channels, full)?)
-            }
-            None => None,
-        };
         let mut output = Output::new(out, lanes.count, channels)?;
         let lane = |i, lobes: &mut _| plate_lane(materials, spectrum, call, &cols, i, lobes);
-        let derive = |i, lobes: &[Slots<PLATE_SLOTS>], choice, inputs: &[Input], out: &mut _| {
-            plate_derivatives(
-                materials,
-                spectrum,
-                call,
-                &cols,
-                i,
-                (lobes, choice),
-                inputs,
-                out,
-            )
-        };
         write_lanes(
             &mut output,
-            derivatives.as_mut(),
             lanes.count,
             &cols.common.active,
             lane,
-            derive,
             plate_component,
         );
         Ok(output.status())
@@ -131,7 +82,6 @@ fn crystal_batch(
     materials: &Materials,
     components: u32,
     lanes: &CrystalLanes,
-    tangents: Option<&mut Tangents>,
     out: &mut Samples,
 ) -> Status {
     let run = || {
@@ -143,26 +93,13 @@ fn crystal_batch(
                 "at least one column is needed",
             ));
         }
-        let full = !out.value[1].is_empty();
-        let mut derivatives = match tangents {
-            Some(t) => {
-                let inputs = crystal_inputs(materials, t.inputs)?;
-                Some(TangentOutput::new(t, inputs, lanes.count, channels, full)?)
-            }
-            None => None,
-        };
         let mut output = Output::new(out, lanes.count, channels)?;
         let lane = |i, lobes: &mut _| crystal_lane(materials, components, &cols, i, lobes);
-        let derive = |i, lobes: &[Slots<CRYSTAL_SLOTS>], choice, inputs: &[Input], out: &mut _| {
-            crystal_derivatives(materials, &cols, i, (lobes, choice), (inputs, !full), out)
-        };
         write_lanes(
             &mut output,
-            derivatives.as_mut(),
             lanes.count,
             &cols.common.active,
             lane,
-            derive,
             crystal_component,
         );
         Ok(output.status())
@@ -179,83 +116,35 @@ pub(super) fn finish(r: Result<Status>, out: &mut Samples) -> Status {
 }
 
 /// Computes each of the call's `count` lanes (`lane(i, lobes)`, skipping inactive ones) and
-/// writes it, with its derivatives (`derive`) if `tangents` asks for them. A lane fills the
-/// channels' slots of `lobes` (one buffer for the call) and returns the chosen slot, if any.
+/// writes it. A lane fills the channels' slots of `lobes` (one buffer for the call) and returns
+/// the chosen slot, if any.
 pub(super) fn write_lanes<const S: usize>(
     output: &mut Output,
-    mut tangents: Option<&mut TangentOutput>,
     count: usize,
     active: &Column<u8>,
     lane: impl Fn(usize, &mut Lobes<S>) -> Result<Option<Choice>>,
-    derive: impl Fn(usize, &[Slots<S>], Choice, &[Input], &mut Columns) -> Result<()>,
     component: fn(usize) -> usize,
 ) {
     let mut lobes = [[None; S]; MAX_CHANNELS];
-    // One lane's derivatives, reused lane after lane (allocated only when asked for).
-    let mut scratch = tangents.as_ref().map(|_| Box::new(Columns::zeros()));
     for i in 0..count {
-        let derived = {
-            let inputs = tangents.as_ref().map_or(&[][..], |t| t.inputs());
-            let derive = &derive;
-            let derive = scratch
-                .as_deref_mut()
-                .map(|out| move |lobes: &[Slots<S>], choice| derive(i, lobes, choice, inputs, out));
-            write_lane(
-                output,
-                i,
-                active.at(i),
-                |l| lane(i, l),
-                &mut lobes,
-                derive,
-                component,
-            )
-        };
-        if let Some(t) = tangents.as_deref_mut() {
-            let d = scratch.as_deref().filter(|_| derived);
-            match d {
-                Some(d) if !t.is_finite(d) => {
-                    output.fail(i, &non_finite());
-                    t.write(i, None);
-                }
-                d => t.write(i, d),
-            }
-        }
-    }
-}
-
-/// Computes lane `i` (unless inactive) into `lobes` and writes it, and its derivatives with
-/// `derive` if given; returns whether they were derived (the lane samples a lobe).
-fn write_lane<const S: usize>(
-    output: &mut Output,
-    i: usize,
-    active: u8,
-    lane: impl FnOnce(&mut Lobes<S>) -> Result<Option<Choice>>,
-    lobes: &mut Lobes<S>,
-    derive: Option<impl FnOnce(&[Slots<S>], Choice) -> Result<()>>,
-    component: fn(usize) -> usize,
-) -> bool {
-    if active == 0 {
-        output.nothing(i);
-        return false;
-    }
-    let written = guarded(|| lane(lobes)).and_then(|choice| match choice {
-        Some(choice) => {
-            let channels = &lobes[..output.channels()];
-            output.write(i, channels, choice, component(choice.slot))?;
-            match derive {
-                Some(d) => guarded(|| d(channels, choice)).map(|()| true),
-                None => Ok(false),
-            }
-        }
-        None => {
+        if active.at(i) == 0 {
             output.nothing(i);
-            Ok(false)
+            continue;
         }
-    });
-    written.unwrap_or_else(|e| {
-        output.fail(i, &e);
-        false
-    })
+        let written = guarded(|| lane(i, &mut lobes)).and_then(|choice| match choice {
+            Some(choice) => {
+                let channels = &lobes[..output.channels()];
+                output.write(i, channels, choice, component(choice.slot))
+            }
+            None => {
+                output.nothing(i);
+                Ok(())
+            }
+        });
+        if let Err(e) = written {
+            output.fail(i, &e);
+        }
+    }
 }
 
 /// The columns both queries share.
@@ -400,43 +289,29 @@ pub(super) fn enabled(components: u32, k: usize) -> bool {
     k < 32 && components & (1 << k) != 0
 }
 
-/// Lane `i`'s inputs of a plate batch that derivatives are taken with respect to.
-fn plate_point(materials: &Materials, cols: &PlateColumns, i: usize) -> Result<Point> {
-    let c = &cols.common;
-    Ok(Point {
-        material: *materials.get(c.material.at(i))?,
-        birefringence: cols.birefringence.at(i),
-        thickness_nm: cols.thickness_nm.at(i),
-        axis_angle_deg: cols.axis_angle_deg.at(i),
-        axis: c.optic_axis.at(i),
-        wi: c.wi.at(i),
-    })
-}
-
-/// The plate's lobes per channel at point `p` of lane `i` (the rest of the query from the
-/// lane's columns).
+/// The plate's lobes per channel of lane `i` over `spectrum`.
 fn plate_at(
+    materials: &Materials,
     call: &PlateCall,
     cols: &PlateColumns,
     i: usize,
-    p: &Point,
     spectrum: &Spectrum,
     transport: Transport,
 ) -> Result<Vec<Slots<PLATE_SLOTS>>> {
     let c = &cols.common;
     let q = PlateQuery::new(
-        p.material,
-        p.birefringence,
+        *materials.get(c.material.at(i))?,
+        cols.birefringence.at(i),
         C64::new(c.ext_ior.at(i), 0.0),
         C64::new(cols.exit_ior.at(i), 0.0),
-        rotated_about(p.axis, p.axis_angle_deg)?,
-        Thickness::new("thickness", p.thickness_nm, Length::Micrometres)?,
+        rotated_about(c.optic_axis.at(i), cols.axis_angle_deg.at(i))?,
+        Thickness::new("thickness", cols.thickness_nm.at(i), Length::Micrometres)?,
         enabled(call.components, 0),
         enabled(call.components, 1),
         call.intensity_only,
     )?
     .with_absorbing_exit(call.absorbing_exit);
-    plate_lobes(&q, spectrum, p.wi, transport)
+    plate_lobes(&q, spectrum, c.wi.at(i), transport)
 }
 
 /// Lane `i` of a plate batch: the scalar plate query and the choice of its lobe.
@@ -450,9 +325,8 @@ fn plate_lane(
 ) -> Result<Option<Choice>> {
     let c = &cols.common;
     let (transport, u) = c.transport_and_sample(i)?;
-    let point = plate_point(materials, cols, i)?;
     let (s, pick) = spectrum.lane(c.wavelengths.at(i), c.wavelengths.count());
-    let per_channel = plate_at(call, cols, i, &point, &s, transport)?;
+    let per_channel = plate_at(materials, call, cols, i, &s, transport)?;
     Ok(choose_thin(&per_channel, pick, call, u, lobes))
 }
 
@@ -487,56 +361,6 @@ pub(super) fn choose_thin(
         ..choice
     };
     choice.map(kept)
-}
-
-/// The derivatives with respect to `inputs` of lane `i` of a plate batch, which sampled
-/// `choice` among `lobes` (a spectrum of wavelengths: `plate_inputs` refuses the others), into
-/// `out`.
-#[allow(clippy::too_many_arguments)]
-fn plate_derivatives(
-    materials: &Materials,
-    spectrum: &PlateSpectrum,
-    call: &PlateCall,
-    cols: &PlateColumns,
-    i: usize,
-    (lobes, choice): (&[Slots<PLATE_SLOTS>], Choice),
-    inputs: &[Input],
-    out: &mut Columns,
-) -> Result<()> {
-    let c = &cols.common;
-    let (transport, _) = c.transport_and_sample(i)?;
-    let (s, _) = spectrum.lane(c.wavelengths.at(i), c.wavelengths.count());
-    let at = |p: &Point| plate_at(call, cols, i, p, &s, transport);
-    let lane = Lane {
-        point: plate_point(materials, cols, i)?,
-        transport,
-        bulk: false,
-        shortest_nm: shortest(&c.wavelengths.at(i)[..c.wavelengths.count()]),
-        lobes,
-        choice,
-        intensity_only: call.intensity_only,
-        at: &at,
-    };
-    lane.derivatives_into(inputs, out);
-    Ok(())
-}
-
-/// The shortest of `wavelengths` (nm).
-fn shortest(wavelengths: &[f64]) -> f64 {
-    wavelengths.iter().copied().fold(f64::INFINITY, f64::min)
-}
-
-/// Lane `i`'s inputs of a crystal batch that derivatives are taken with respect to.
-fn crystal_point(materials: &Materials, cols: &CrystalColumns, i: usize) -> Result<Point> {
-    let c = &cols.common;
-    Ok(Point {
-        material: *materials.get(c.material.at(i))?,
-        birefringence: 0.0,
-        thickness_nm: 0.0,
-        axis_angle_deg: 0.0,
-        axis: c.optic_axis.at(i),
-        wi: c.wi.at(i),
-    })
 }
 
 /// The crystal's slots per wavelength of lane `i` (`material`, `axis` and `wi`: the lane's or a
@@ -584,34 +408,4 @@ fn crystal_lane(
         |slot| enabled(components, crystal_component(slot)),
         u,
     ))
-}
-
-/// The derivatives with respect to `inputs` of lane `i` of a crystal batch, which sampled
-/// `choice` among `lobes`, into `out` (`intensity_only`: of the weight's `M00` alone).
-fn crystal_derivatives(
-    materials: &Materials,
-    cols: &CrystalColumns,
-    i: usize,
-    (lobes, choice): (&[Slots<CRYSTAL_SLOTS>], Choice),
-    (inputs, intensity_only): (&[Input], bool),
-    out: &mut Columns,
-) -> Result<()> {
-    let c = &cols.common;
-    let (transport, _) = c.transport_and_sample(i)?;
-    let at = |p: &Point| {
-        let mut slots = vec![[None; CRYSTAL_SLOTS]; c.wavelengths.count()];
-        crystal_at(cols, i, (&p.material, p.axis, p.wi), transport, &mut slots).map(|_| slots)
-    };
-    let lane = Lane {
-        point: crystal_point(materials, cols, i)?,
-        transport,
-        bulk: true,
-        shortest_nm: shortest(&c.wavelengths.at(i)[..c.wavelengths.count()]),
-        lobes,
-        choice,
-        intensity_only,
-        at: &at,
-    };
-    lane.derivatives_into(inputs, out);
-    Ok(())
 }

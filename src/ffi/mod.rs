@@ -21,9 +21,8 @@ mod programs;
 mod samples;
 mod spectrum;
 mod stack;
-mod tangents;
 
-pub use batch::{sample_crystal, sample_crystal_tangents, sample_plate, sample_plate_tangents};
+pub use batch::{sample_crystal, sample_plate};
 pub use materials::{new_materials, Materials};
 pub use programs::{record_crystal, record_plate, record_stack, Program};
 pub use spectrum::{
@@ -31,7 +30,6 @@ pub use spectrum::{
     default_channel, exact_spectrum, srgb_spectrum, PlateSpectrum,
 };
 pub use stack::sample_stack;
-pub use tangents::{crystal_tangents_available, plate_tangents_available};
 
 /// The library's version.
 pub fn version() -> &'static str {
@@ -212,49 +210,6 @@ pub mod bridge {
         value: [&'a mut [f64]; 16],
         /// The message of the first lane (or call) that failed.
         message: String,
-    }
-
-    /// An input of a query that derivatives can be taken with respect to (`Tangents::inputs`),
-    /// in the units of the lanes' columns.
-    #[repr(u8)]
-    #[derive(Debug)]
-    enum Tangent {
-        /// A plate's `thickness_nm`.
-        Thickness = 0,
-        /// A plate's `birefringence`.
-        Birefringence = 1,
-        /// A plate's `axis_angle_deg`.
-        AxisAngle = 2,
-        /// The real part of the ordinary index (a material of constant indices).
-        EtaO = 3,
-        /// The real part of the extraordinary index (a material of constant indices).
-        EtaE = 4,
-        /// The ordinary extinction coefficient `kappa_o`.
-        KappaO = 5,
-        /// The extraordinary extinction coefficient `kappa_e`.
-        KappaE = 6,
-        /// `optic_axis`: three columns (x, y, z).
-        OpticAxis = 7,
-        /// `wi`: three columns (x, y, z).
-        Wi = 8,
-    }
-
-    /// The derivatives a query asks for (attached sampling: the lobe choice and its probability
-    /// are held fixed; see `render::tangents`), and where they are written. Each input gives
-    /// one derivative column (a vector input three: x, y, z), in the order of `inputs`; each
-    /// input at most once. Column k of lane i: `d wo[j]` at `wo[j][k * count + i]`; `d value[e]`
-    /// (the sample weight, as `Samples::value`, but *in Mitsuba's implicit Stokes frames*
-    /// `stokes_basis(-wo_hat) -> stokes_basis(wi_hat)`) of channel c at
-    /// `value[e][(k * channels + c) * count + i]`. `value[1..16]` are empty exactly when the
-    /// samples' are (intensity only). A lane that samples nothing has zero derivatives.
-    #[derive(Debug)]
-    struct Tangents<'a> {
-        /// The inputs, in order.
-        inputs: &'a [Tangent],
-        /// Derivatives of `wo`.
-        wo: [&'a mut [f64]; 3],
-        /// Derivatives of the sample weight, per channel, in Mitsuba's implicit frames.
-        value: [&'a mut [f64]; 16],
     }
 
     /// An operation of a recorded program (`crate::record::Op`, in the same order): numbers
@@ -587,6 +542,8 @@ pub mod bridge {
         fn colour_channel_wavelength(name: &str) -> Result<f64>;
         /// Channels of a query with `wavelengths` wavelength columns.
         fn channels(self: &PlateSpectrum, wavelengths: usize) -> usize;
+        /// Why a query over this spectrum has no derivatives (empty: it has them).
+        fn gradients_refused(self: &PlateSpectrum) -> String;
 
         /// Samples a plate lobe (slot 0 reflection, 1 transmission) in every lane. Returns
         /// `Ok` if every lane succeeded, else the status of the first failure (the call's own,
@@ -617,40 +574,6 @@ pub mod bridge {
             lanes: &CrystalLanes,
             out: &mut Samples,
         ) -> Status;
-
-        /// `sample_plate` with the derivatives `tangents` asks for.
-        fn sample_plate_tangents(
-            materials: &Materials,
-            spectrum: &PlateSpectrum,
-            call: &PlateCall,
-            lanes: &PlateLanes,
-            tangents: &mut Tangents,
-            out: &mut Samples,
-        ) -> Status;
-
-        /// `sample_crystal` with the derivatives `tangents` asks for.
-        fn sample_crystal_tangents(
-            materials: &Materials,
-            components: u32,
-            lanes: &CrystalLanes,
-            tangents: &mut Tangents,
-            out: &mut Samples,
-        ) -> Status;
-
-        /// Succeeds if a plate query over `spectrum` with the materials of `materials` can give
-        /// derivatives with respect to `inputs`; else the reason, naming what to change (for
-        /// now the exact plate at each wavelength only: `filter_bandwidth` 0 in the spectral
-        /// variants; not yet over colour channels).
-        fn plate_tangents_available(
-            materials: &Materials,
-            spectrum: &PlateSpectrum,
-            inputs: &[Tangent],
-        ) -> Result<()>;
-
-        /// Succeeds if a crystal query with the materials of `materials` can give derivatives
-        /// with respect to `inputs`; else the reason (e.g. `kappa_o` of a birefringent crystal,
-        /// which cannot absorb).
-        fn crystal_tangents_available(materials: &Materials, inputs: &[Tangent]) -> Result<()>;
 
         /// The library's version.
         fn version() -> &'static str;

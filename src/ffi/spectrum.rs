@@ -108,25 +108,18 @@ impl PlateSpectrum {
         }
     }
 
-    /// Succeeds if a plate query over this spectrum gives derivatives (`render::tangents`): the
-    /// exact plate at each wavelength does. The closed-form integrals over a band or over colour
-    /// channels do not yet; the error says what to use instead.
-    pub fn check_tangents(&self) -> Result<()> {
+    /// Why a query over this spectrum has no derivatives, or nothing for the exact plate at
+    /// each wavelength (its recorded program carries Dr.Jit's derivatives). The closed-form
+    /// integrals over a band or over colour channels run in the core on the host, outside
+    /// Dr.Jit's graph: a gradient through them would silently be 0, so the shim refuses it
+    /// with this reason.
+    pub fn gradients_refused(&self) -> String {
         let instead = "render gradients in llvm_ad_spectral or llvm_ad_spectral_polarized with filter_bandwidth 0, where the plate is exact at each sampled wavelength";
         match *self {
-            PlateSpectrum::Bands { fwhm_nm: 0.0 } => Ok(()),
-            PlateSpectrum::Bands { fwhm_nm } => Err(Error::new(
-                "filter_bandwidth",
-                format!("gradients of a plate averaged over a band ({fwhm_nm} nm) are not available yet: set filter_bandwidth to 0 ({instead})"),
-            )),
-            PlateSpectrum::Srgb => Err(Error::new(
-                "variant",
-                format!("gradients of a plate integrated over the sRGB channels (llvm_ad_rgb) are not available yet: {instead}"),
-            )),
-            PlateSpectrum::Channel(c) => Err(Error::new(
-                "variant",
-                format!("gradients of a plate integrated over the colour channel \"{}\" (llvm_ad_mono, llvm_ad_mono_polarized) are not available yet: {instead}", c.name()),
-            )),
+            PlateSpectrum::Bands { fwhm_nm } if fwhm_nm == 0.0 => String::new(),
+            PlateSpectrum::Bands { fwhm_nm } => format!("filter_bandwidth: gradients of a plate averaged over a band ({fwhm_nm} nm) are not available: set filter_bandwidth to 0 ({instead})"),
+            PlateSpectrum::Srgb => format!("variant: gradients of a plate integrated over the sRGB channels (llvm_ad_rgb) are not available: {instead}"),
+            PlateSpectrum::Channel(c) => format!("variant: gradients of a plate integrated over the colour channel \"{}\" (llvm_ad_mono, llvm_ad_mono_polarized) are not available: {instead}", c.name()),
         }
     }
 

@@ -33,14 +33,11 @@ pub fn sample_stack(
         let channels = spectrum.channels(cols.wavelengths.count());
         let mut output = Output::new(out, lanes.count, channels)?;
         let lane = |i, lobes: &mut _| stack_lane(materials, spectrum, call, &cols, i, lobes);
-        // Stacks carry no derivatives: no tangent output, and nothing to derive.
         write_lanes(
             &mut output,
-            None,
             lanes.count,
             &cols.active,
             lane,
-            |_, _, _, _, _| Ok(()),
             plate_component,
         );
         Ok(output.status())

@@ -9,11 +9,11 @@
 //! plate's colour lies outside the gamut: a lobe negative in every channel of the query, as in
 //! a one-channel render, must still be chosen for the expectation to hold). The probabilities
 //! are thus the same in both transport modes and, for a dielectric interface, those of
-//! Mitsuba's `dielectric` (its Fresnel `R` and `T`): with the probability detached, the
-//! gradient of an attached sample's weight is then the built-in's (`render::tangents`). The
+//! Mitsuba's `dielectric` (its Fresnel `R` and `T`): with the probability detached (a recorded
+//! program's `detach`), the gradient of an attached sample's weight is then the built-in's. The
 //! ray follows the slot's direction in the first channel that has it (the hero wavelength), and
-//! every channel carries its own lobe of that slot divided by the probability. With dispersion the other wavelengths
-//! are thus propagated along the hero's direction: their Fresnel, polarisation, o/e split and
+//! every channel carries its own lobe of that slot divided by the probability. With dispersion
+//! the other wavelengths are thus propagated along the hero's direction: their Fresnel, polarisation, o/e split and
 //! radiance factor are exact, their angular dispersion (~0.5 degrees over the visible for
 //! calcite) is neglected. A slot that is the only candidate is chosen with probability 1 whatever
 //! its weight (the single-lobe convention of Mitsuba's own BSDFs: the sample's value is then

@@ -12,11 +12,9 @@
 pub mod choice;
 pub mod crystal;
 pub mod isotropic;
-pub mod mitsuba_frames;
 pub mod plate;
 pub mod slots;
 pub mod stack;
-pub mod tangents;
 pub mod thin;
 
 use crate::real::{Mask, Real, Select};

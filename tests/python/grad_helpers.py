@@ -23,7 +23,7 @@ import drjit as dr
 import mitsuba as mi
 import numpy as np
 
-from jit_helpers import evaluated_mode
+from jit_helpers import evaluated_mode, floats
 
 #: Relative tolerance of a derivative against the finite differences (the issue's bar), beside
 #: an absolute floor of FLOOR times the largest derivative of the comparison ("not tiny"), and
@@ -93,10 +93,15 @@ def evaluate(make, s, null: bool = False):
         bsdf, si, u, ctx = make(s)
         if null:
             w = bsdf.eval_null_transmission(si)
+            dr.eval(w)
             return w, None, None
         bs, w = bsdf.sample(ctx, si, u, mi.Point2f(0.5, 0.5))
+        lobe = w * dr.detach(bs.pdf)
+        # Every output in one kernel (the graph stays attached): read entry by entry, each
+        # would be a kernel of its own, compiled anew.
+        dr.eval(lobe, bs.wo, bs.sampled_component)
         wo = np.array(dr.detach(bs.wo), dtype=np.float64)
-        return w * dr.detach(bs.pdf), np.array(bs.sampled_component), wo
+        return lobe, np.array(bs.sampled_component), wo
 
 
 def as_numpy(x) -> np.ndarray:
@@ -179,10 +184,10 @@ def projection(w, r: np.ndarray):
         for i in range(4):
             for j in range(4):
                 for c in range(r.shape[2]):
-                    total += dr.sum(w[i, j][c] * mi.Float(r[i, j, c].astype(np.float32)))
+                    total += dr.sum(w[i, j][c] * floats(r[i, j, c]))
     else:  # (channels, lanes)
         for c in range(r.shape[0]):
-            total += dr.sum(w[c] * mi.Float(r[c].astype(np.float32)))
+            total += dr.sum(w[c] * floats(r[c]))
     return total
 
 

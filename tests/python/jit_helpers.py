@@ -37,6 +37,17 @@ def random_directions(n: int, rng: np.random.Generator, min_abs_cos: float = 1e-
     return d
 
 
+def floats(x: np.ndarray):
+    """A Dr.Jit Float of the values `x`, in memory Dr.Jit allocated and aligned. An array made
+    from numpy's memory may be unaligned (a slice, a column), and Dr.Jit then compiles another
+    kernel for that input's alignment (a large one per evaluation, about a second each on a
+    recorded program): `dr.copy` and an identity gather keep the unaligned memory, building from
+    Python numbers does not."""
+    f = mi.Float(np.asarray(x, dtype=np.float32).ravel().tolist())
+    dr.eval(f)
+    return f
+
+
 def batch_si(wi: np.ndarray, wavelengths: np.ndarray | None = None, uv: np.ndarray | None = None):
     """A surface interaction of len(wi) lanes in the local frame (normal +z), seen from `wi`;
     `wavelengths` (lanes x 4, nm) in spectral variants; `uv` (lanes x 2) for textures."""
@@ -44,12 +55,12 @@ def batch_si(wi: np.ndarray, wavelengths: np.ndarray | None = None, uv: np.ndarr
     si = dr.zeros(mi.SurfaceInteraction3f, n)
     si.n = mi.Normal3f(0, 0, 1)
     si.sh_frame = mi.Frame3f(si.n)
-    si.wi = mi.Vector3f(*[mi.Float(np.ascontiguousarray(wi[:, k], dtype=np.float32)) for k in range(3)])
+    si.wi = mi.Vector3f(*[floats(wi[:, k]) for k in range(3)])
     if uv is not None:
-        si.uv = mi.Point2f(mi.Float(uv[:, 0]), mi.Float(uv[:, 1]))
+        si.uv = mi.Point2f(floats(uv[:, 0]), floats(uv[:, 1]))
     if mi.is_spectral:
         w = wavelengths if wavelengths is not None else np.tile([450.0, 500.0, 550.0, 600.0], (n, 1))
-        si.wavelengths = mi.UnpolarizedSpectrum(*[mi.Float(w[:, k]) for k in range(4)])
+        si.wavelengths = mi.UnpolarizedSpectrum(*[floats(w[:, k]) for k in range(4)])
     return si
 
 
@@ -68,7 +79,7 @@ def sample(bsdf, ctx, si, u: np.ndarray):
     n = len(u)
     lanes = lambda x: np.broadcast_to(np.array(x), np.array(x).shape[:-1] + (n,))  # noqa: E731
     with evaluated_mode():
-        bs, w = bsdf.sample(ctx, si, mi.Float(np.asarray(u, dtype=np.float32)), mi.Point2f(0.5, 0.5))
+        bs, w = bsdf.sample(ctx, si, floats(u), mi.Point2f(0.5, 0.5))
         out = {"wo": lanes(bs.wo).T, "pdf": lanes(bs.pdf), "eta": lanes(bs.eta),
                "component": lanes(bs.sampled_component), "type": lanes(bs.sampled_type)}
         return out, lanes(w)

@@ -17,8 +17,8 @@ direction too.
   isotropic limit with a built-in counterpart.)
 
 Agreement to Mitsuba's own tolerance (`dr.allclose`: 1e-5 relative), with an absolute floor of
-1e-6 of the largest entry for float32 rounding; the plugins' derivatives are central
-differences in double precision (tests/tangents.rs).
+1e-6 of the largest entry for float32 rounding; the plugins' derivatives are Dr.Jit's AD
+through their replayed programs (docs/gradients.md).
 """
 
 from __future__ import annotations

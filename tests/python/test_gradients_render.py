@@ -1,11 +1,11 @@
 """Gradients of whole renders (`mi.render`, the `path` integrator, llvm_ad_spectral_polarized, in
-evaluated mode) with respect to every differentiable parameter, forward and reverse mode,
+Mitsuba's default mode) with respect to every differentiable parameter, forward and reverse mode,
 against central finite differences of the same renders (same seed; Richardson-extrapolated,
 float32 images), within 1e-3 relative where the derivative is not tiny, beyond the finite
 differences' own error: the images' float32 rounding over the step, which differs from machine
-to machine (RENDER_ULPS), and their truncation error (grad_helpers.fd_error). The exact
-derivatives of the plugins' lobes are tested in f64 by tests/tangents.rs, their float32
-lobes by test_gradients_bsdf.py; here the render's wiring.
+to machine (RENDER_ULPS), and their truncation error (grad_helpers.fd_error). The plugins'
+lobes' derivatives (Dr.Jit's AD through the replayed programs) are tested lane by lane by
+test_gradients_bsdf.py; here the render's wiring.
 
 Why single-lobe scenes: attached sampling differentiates each sample's weight with its lobe
 choice held fixed, which is unbiased for the derivative of the expected image; a finite
@@ -30,6 +30,7 @@ moving visibility edge (the surfaces fill the view):
 
 from __future__ import annotations
 
+import contextlib
 import math
 
 import drjit as dr
@@ -37,8 +38,8 @@ import mitsuba as mi
 import numpy as np
 import pytest
 
-from grad_helpers import Derivatives, check, finite_differences, moved
-from jit_helpers import evaluated_mode
+from grad_helpers import Derivatives, check, finite_differences, moved, step
+from jit_helpers import evaluated_mode, floats
 
 POLARIZED = "llvm_ad_spectral_polarized"
 H = {k: 2.0 ** -k for k in range(20)}
@@ -75,11 +76,14 @@ RENDER_ULPS = 16.0
 
 
 def render_derivatives(scene_dict: dict, keys: str, direction, h: float,
-                       forward_mode=True) -> Derivatives:
+                       forward_mode=True, evaluated=False) -> Derivatives:
     """The derivatives of `mi.render` with respect to `s`, the parameters `keys` being moved by
     `direction * s`: forward mode (`forward_mode` False: the finite differences stand in for
     it), reverse mode of a random projection, and the finite differences of the same renders
-    with their error bound."""
+    with their error bound. Rendered in Mitsuba's default (symbolic) mode, or in evaluated mode
+    (`evaluated`: Python integrators that record `if` statements on arrays, section 4 of
+    docs/gradients.md). Every `s` is opaque and carries gradients, so that each render runs
+    the same kernels (a literal would be compiled into kernels of its own)."""
     scene = mi.load_dict(scene_dict)
     params = mi.traverse(scene)
     base = {k: type(params[k])(params[k]) for k in keys.split("+")}
@@ -94,19 +98,17 @@ def render_derivatives(scene_dict: dict, keys: str, direction, h: float,
         params.update()
         return mi.render(scene, params, seed=seed, spp=2)
 
-    with evaluated_mode():
+    with evaluated_mode() if evaluated else contextlib.nullcontext():
         fd, fd_err = finite_differences(
-            lambda s: np.array(render(mi.Float(s), seed_grad), dtype=np.float64), h, RENDER_ULPS)
+            lambda s: np.array(render(step(s), seed_grad), dtype=np.float64), h, RENDER_ULPS)
         forward = fd
         if forward_mode:
-            s = mi.Float(0.0)
-            dr.enable_grad(s)
+            s = step(0.0)
             out = render(s)
             dr.forward(s)
             forward = np.array(dr.grad(out), dtype=np.float64)
         r = np.random.default_rng(11).normal(size=fd.shape)
-        s = mi.Float(0.0)
-        dr.enable_grad(s)
+        s = step(0.0)
         out = render(s)
         dr.backward(dr.sum(out * mi.TensorXf(r.astype(np.float32)), axis=None))
         reverse = float(dr.grad(s)[0])
@@ -222,7 +224,7 @@ def refraction_image(key: str, direction, s, component: int):
     x, y = [a.ravel().astype(np.float32) for a in np.meshgrid(g, g)]
     t = math.radians(35.0)
     d = mi.Vector3f(math.sin(t), 0.2, -math.cos(t))
-    ray = mi.Ray3f(o=mi.Point3f(mi.Float(x), mi.Float(y), mi.Float(np.full_like(x, 2.0))),
+    ray = mi.Ray3f(o=mi.Point3f(floats(x), floats(y), floats(np.full_like(x, 2.0))),
                    d=dr.normalize(d), wavelengths=mi.UnpolarizedSpectrum(450.0, 520.0, 590.0, 660.0))
     with evaluated_mode():
         si = scene.ray_intersect(ray)
@@ -290,7 +292,7 @@ def test_prb_in_the_unpolarized_variants(variant, integrator):
     mi.set_variant(variant)
     spectral = variant == "llvm_ad_spectral"
     check_render(render_derivatives(prb_scene(integrator), "floor.bsdf.reflectance.value",
-                                    1.0, H[6], forward_mode=not spectral))
+                                    1.0, H[6], forward_mode=not spectral, evaluated=True))
     if not spectral:
         return
     for name, expect_zero in ((integrator, True), ("path", False)):

@@ -23,7 +23,7 @@ import mitsuba as mi
 import numpy as np
 import pytest
 
-from jit_helpers import batch_si, context, random_directions
+from jit_helpers import batch_si, context, floats, random_directions
 
 TOL = 4e-6
 DIR_TOL = 1e-6
@@ -139,7 +139,7 @@ def jit_lanes(variant, desc, mode, wi, uv, waves, u, null):
                                          np.array(x).shape[:-1] + (n,))
     if null:
         return lanes_of(bsdf.eval_null_transmission(si))
-    bs, w = bsdf.sample(context(mode), si, mi.Float(u), mi.Point2f(0.5, 0.5))
+    bs, w = bsdf.sample(context(mode), si, floats(u), mi.Point2f(0.5, 0.5))
     return (lanes_of(bs.wo).T, lanes_of(bs.pdf), lanes_of(bs.eta),
             lanes_of(bs.sampled_component), lanes_of(w))
 

@@ -248,10 +248,10 @@ def test_textures_per_layer_drive_the_stack():
         np.testing.assert_array_equal(lobe(s, si, "radiance", 1), want)
 
 
-def test_layers_are_not_differentiable():
-    """No gradient flows through a stack yet: a nested plate's parameters, differentiable on a
-    plate of its own in the llvm_ad variants, are flagged not differentiable as a layer (so
-    that Mitsuba refuses to differentiate them rather than give a zero gradient)."""
+def test_layers_are_differentiable_as_their_plates():
+    """A nested plate's parameters, differentiable on a plate of its own in the llvm_ad
+    variants, are differentiable as a stack's layer too (their derivatives come from the
+    replayed program: test_gradients_bsdf.py's stack cases)."""
     variant("llvm_ad_spectral_polarized")
     plate = mi.traverse(mi.load_dict(layer()))
     layers = mi.traverse(stack(layer(), layer(axis_angle=45.0)))
@@ -259,7 +259,7 @@ def test_layers_are_not_differentiable():
     for key in ("eta_o", "kappa_e", "optic_axis", "thickness.value", "axis_angle.value"):
         if key in plate:
             assert not plate.flags(key) & nondiff, key
-        assert layers.flags(f"layer_1.{key}") & nondiff, key
+            assert not layers.flags(f"layer_1.{key}") & nondiff, key
 
 
 @pytest.mark.parametrize("name", mitsuba_birefringent.VARIANTS)

@@ -28,6 +28,12 @@ pub fn record_crystal(materials: &Materials, recipe: &CrystalRecipe) -> Result<B
         ));
     }
     let ext = check_clear_index("ext_ior", C64::new(recipe.ext_ior, 0.0))?.re;
+    if recipe.kappas_are_inputs && !material.is_isotropic() {
+        return Err(Error::new(
+            "kappa_o",
+            "has no derivative for a birefringent crystal: it cannot absorb (an absorbing birefringent bulk is refused, see kappa_o), so kappa_o and kappa_e stay 0; keep kappa_o and kappa_e out of the optimisation",
+        ));
+    }
     if !recipe.axis_is_input {
         let one = C64::new(1.0, 0.0);
         Uniaxial::new(one, one, recipe.optic_axis.into())?;
