@@ -34,6 +34,8 @@
 #[path = "../tests/spectral_rgb.rs"]
 mod spectral_rgb;
 
+use birefringent::colour::weights::weight_per_nm;
+use birefringent::colour::weights::WeightSet;
 use birefringent::material::Material;
 use birefringent::optics::frame::PlaneFrame;
 use birefringent::optics::interface::Interface;
@@ -42,11 +44,10 @@ use birefringent::params::Thickness;
 use birefringent::plate::slab::Output;
 use birefringent::plate::slab::{Slab, SlabOptics, Want};
 use birefringent::plate::Plate;
-use birefringent::spectral::model::{Accuracy, PlateModel};
+use birefringent::quadrature::Accuracy;
+use birefringent::spectral::model::PlateModel;
 use birefringent::spectral::route::{self, Route};
 use birefringent::spectral::survey::Survey;
-use birefringent::spectral::weights::weight_per_nm;
-use birefringent::spectral::weights::WeightSet;
 use birefringent::C64;
 use serde_json::{json, Value};
 use spectral_rgb::{Case, Outcome, Rng, QUANTITIES, RANGE, SET};

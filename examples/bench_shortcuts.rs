@@ -13,11 +13,11 @@
 //! decides them:
 //!
 //! * `intensity_only` (`PlateCall::intensity_only`, set by the plugin in the unpolarised variants;
-//!   `Output::Intensity` in `spectral::integrate::band_sum`): only `M00` of each path-class pair
+//!   `Output::Intensity` in `spectral::gaussian::band_sum`): only `M00` of each path-class pair
 //!   instead of the full coherency matrix. Full = the same query with `Output::Mueller`. It acts
 //!   only where the closed-form path sum runs (band-filtered or RGB queries of plates too thick
 //!   for quadrature); timed on a 1000 um plate through a 4 nm band (`Spectrum::Band`).
-//! * `incoherent_thick_plate` (`coherent_order` in `spectral::integrate`: at most `THICK_ORDER`
+//! * `incoherent_thick_plate` (`coherent_order` in `spectral::gaussian`: at most `THICK_ORDER`
 //!   coherent round trips plus the closed-form incoherent tail when one round trip exceeds the
 //!   coherence length). Full = the coherent path sum to the order where the round-trip
 //!   amplitude falls below `ORDER_TOLERANCE` for that query (the order the core uses for plates
@@ -47,9 +47,10 @@ use birefringent::plate::slab::Output;
 use birefringent::plate::slab::Want;
 use birefringent::plate::Plate;
 use birefringent::render::crystal::crystal_lobes;
-use birefringent::render::plate::{plate_lobes, PlateQuery, Spectrum};
+use birefringent::render::plate::{plate_lobes, PlateQuery};
+use birefringent::render::thin::Spectrum;
 use birefringent::render::Transport;
-use birefringent::spectral::integrate::{integrate_with, Method};
+use birefringent::spectral::gaussian::{band_with, Method};
 use birefringent::C64;
 use nalgebra::Vector3;
 use serde_json::{json, Value};
@@ -257,8 +258,7 @@ fn main() {
                 let beta = plate.ext * (wi.x * wi.x + wi.y * wi.y).sqrt();
                 let band = [narrow_band(lambda, 4.0)];
                 black_box(
-                    integrate_with(&plate, &frame, beta, &band, both, Output::Mueller, method)
-                        .unwrap(),
+                    band_with(&plate, &frame, beta, &band, both, Output::Mueller, method).unwrap(),
                 );
             }
         };

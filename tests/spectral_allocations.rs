@@ -4,14 +4,15 @@
 //! global allocator. The first query of a plate builds what is shared by all queries (rules,
 //! layouts, per-thread working memory), which is no per-query cost.
 
+use birefringent::colour::weights::WeightSet;
 use birefringent::material::Material;
 use birefringent::optics::frame::PlaneFrame;
 use birefringent::plate::slab::{Output, Want};
 use birefringent::plate::Plate;
-use birefringent::spectral::model::{Accuracy, PlateModel};
+use birefringent::quadrature::Accuracy;
+use birefringent::spectral::model::PlateModel;
 use birefringent::spectral::route::{self, Route};
 use birefringent::spectral::survey::Survey;
-use birefringent::spectral::weights::WeightSet;
 use birefringent::C64;
 use nalgebra::Vector3;
 use std::alloc::{GlobalAlloc, Layout, System};

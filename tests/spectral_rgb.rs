@@ -32,13 +32,15 @@
 //! (`--validate N`), which includes this file as a module.
 #![allow(dead_code)]
 
+use birefringent::colour::convert::{ciede2000, xyz_to_lab};
+use birefringent::colour::weights::{gaussians, weight_per_nm, WeightSet};
 use birefringent::material::{Index, Material};
 use birefringent::optics::frame::PlaneFrame;
 use birefringent::plate::slab::Output;
 use birefringent::plate::slab::{SlabMueller, Want};
 use birefringent::plate::Plate;
-use birefringent::spectral::model::{Accuracy, PlateModel};
-use birefringent::spectral::weights::{ciede2000, gaussians, weight_per_nm, xyz_to_lab, WeightSet};
+use birefringent::quadrature::Accuracy;
+use birefringent::spectral::model::PlateModel;
 use birefringent::C64;
 use nalgebra::Vector3;
 use std::time::Instant;
@@ -361,7 +363,7 @@ fn round_trip_reflectance(case: &Case) -> f64 {
 }
 
 /// Dense quadrature of the exact plate: the trapezoid rule of
-/// [`birefringent::spectral::integrate::quadrature`] (same nodes, same weights), with one
+/// [`birefringent::spectral::reference::quadrature`] (same nodes, same weights), with one
 /// evaluation of the plate per wavelength shared by the three channels and quantities.
 pub struct Reference {
     /// With the tabulated weights (`weight_per_nm`): the reference.
@@ -661,7 +663,7 @@ fn single_pass_reference_is_the_library_quadrature() {
         let step = quadrature_step(&case).max(0.05);
         let ours = reference(&case, step, false);
         for c in 0..3 {
-            let lib = birefringent::spectral::integrate::quadrature(
+            let lib = birefringent::spectral::reference::quadrature(
                 &case.plate,
                 &case.frame(),
                 case.beta(),

@@ -2,21 +2,22 @@
 //! route sends it (`spectral::route`), against a dense quadrature of the exact plate with the
 //! fitted Gaussian weights themselves as the spectrum: that isolates each method's own error
 //! from the fit's (which `tests/spectral_rgb.rs` measures in CIEDE2000). Each approximation of
-//! a method is held to 1e-5 of the white response (`spectral::budget`); several add up, so every
+//! a method is held to 1e-5 of the white response (`quadrature::budget`); several add up, so every
 //! Mueller entry of every channel must agree within 1e-4. Also: a plate of zero thickness is
 //! the bare interface it reduces to, to rounding.
 
 mod common;
 
+use birefringent::colour::weights::{fit_per_wavenumber, gaussians, WeightSet};
 use birefringent::material::Material;
 use birefringent::optics::frame::PlaneFrame;
 use birefringent::optics::fresnel::Fresnel;
 use birefringent::plate::slab::{Output, SlabMueller, Want};
 use birefringent::plate::Plate;
-use birefringent::spectral::model::{Accuracy, PlateModel};
+use birefringent::quadrature::Accuracy;
+use birefringent::spectral::model::PlateModel;
 use birefringent::spectral::route::{self, Route};
 use birefringent::spectral::survey::Survey;
-use birefringent::spectral::weights::{fit_per_wavenumber, gaussians, WeightSet};
 use birefringent::C64;
 use nalgebra::{Matrix4, Vector3};
 use std::f64::consts::TAU;

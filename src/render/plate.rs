@@ -3,18 +3,18 @@
 //! transport modes, [`crate::render::thin`] for the lobes of a thin element).
 
 use crate::band::{is_exact_band, narrow_band};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::material::check_clear_index;
-use crate::material::{check_wavelength, Material};
+use crate::material::Material;
 use crate::optics::frame::PlaneFrame;
 use crate::optics::medium::Uniaxial;
-use crate::params::{Bandwidth, Thickness};
+use crate::params::Thickness;
 use crate::plate::slab::{Output, SlabMueller, Want};
 use crate::plate::Plate;
-use crate::render::thin::{self, Thin};
+use crate::quadrature::Accuracy;
+use crate::render::thin::{self, Spectrum, Thin};
 use crate::render::{PathLobe, Transport};
-use crate::spectral::model::{Accuracy, PlateModel};
-use crate::spectral::weights::WeightSet;
+use crate::spectral::model::PlateModel;
 use nalgebra::Vector3;
 use num_complex::Complex64 as C64;
 
@@ -30,84 +30,6 @@ pub struct PlateQuery {
     /// The exit medium absorbs whatever enters it (a film on a black substrate): no
     /// transmission lobe, and no light from below (it cannot reach the plate).
     pub absorbing_exit: bool,
-}
-
-/// Over which spectrum a plate query is evaluated.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Spectrum {
-    /// One wavelength: exact if `fwhm_nm == 0`, else a Gaussian band of that FWHM (closed form).
-    Band {
-        /// Centre wavelength (nm).
-        wavelength_nm: f64,
-        /// Full width at half maximum (nm).
-        fwhm_nm: f64,
-    },
-    /// Every channel of a weight set (closed form).
-    Weights(WeightSet),
-    /// The first `count` (at most [`MAX_BANDS`]) wavelengths of `wavelengths_nm`, each as
-    /// [`Spectrum::Band`] with the same `fwhm_nm`: the wavelengths a spectral renderer traces
-    /// along one path, answered in one query (a plate's wavelength-independent work is shared).
-    Bands {
-        /// Centre wavelengths (nm).
-        wavelengths_nm: [f64; MAX_BANDS],
-        /// How many of them are used.
-        count: usize,
-        /// Full width at half maximum (nm).
-        fwhm_nm: f64,
-    },
-}
-
-/// Most wavelengths of one [`Spectrum::Bands`] query (Mitsuba's spectral variants trace 4).
-pub const MAX_BANDS: usize = 4;
-
-impl Spectrum {
-    /// True if a channel's weight can be negative (linear sRGB: out-of-gamut colours give a
-    /// negative channel value, which is the colour, not an error).
-    pub(crate) fn is_signed(&self) -> bool {
-        matches!(self, Spectrum::Weights(set) if set.is_signed())
-    }
-
-    /// Channels of the answer.
-    pub(crate) fn channels(&self) -> Result<usize> {
-        match *self {
-            Spectrum::Band { .. } => Ok(1),
-            Spectrum::Weights(_) => Ok(3),
-            Spectrum::Bands { count, .. } if (1..=MAX_BANDS).contains(&count) => Ok(count),
-            Spectrum::Bands { count, .. } => Err(Error::new(
-                "count",
-                format!("must be 1 to {MAX_BANDS} wavelengths, got {count}"),
-            )),
-        }
-    }
-
-    /// Checks every band's wavelength and `filter_bandwidth` ([`Bandwidth`]), once per query.
-    pub(crate) fn validate(&self) -> Result<()> {
-        for (wavelength_nm, fwhm_nm) in self.bands() {
-            check_wavelength(wavelength_nm)?;
-            Bandwidth::new("filter_bandwidth", fwhm_nm, wavelength_nm)?;
-        }
-        Ok(())
-    }
-
-    /// The single bands `(wavelength_nm, fwhm_nm)` of a [`Spectrum::Band`] or
-    /// [`Spectrum::Bands`] (empty for weights).
-    pub(crate) fn bands(&self) -> Vec<(f64, f64)> {
-        match *self {
-            Spectrum::Band {
-                wavelength_nm,
-                fwhm_nm,
-            } => vec![(wavelength_nm, fwhm_nm)],
-            Spectrum::Bands {
-                wavelengths_nm,
-                count,
-                fwhm_nm,
-            } => wavelengths_nm[..count.min(MAX_BANDS)]
-                .iter()
-                .map(|&l| (l, fwhm_nm))
-                .collect(),
-            Spectrum::Weights(_) => Vec::new(),
-        }
-    }
 }
 
 impl PlateQuery {

@@ -7,7 +7,7 @@
 //! ([`crate::plate::paths`]); the coherency's pairs of classes are grouped by what their
 //! spectral factor depends on ([`crate::spectral::layout`]). A group oscillates as
 //! `e^{iφ_Δ(k)}` around its group path `G_Δ = φ_Δ'(k₀)` and integrates against every channel
-//! by the fringe rules of [`crate::spectral::fringe`]:
+//! by the fringe rules of [`crate::quadrature::fringe`]:
 //!
 //! ```text
 //! ∫ w_c(k) K_Δ(k) dk = e^{iφ_Δ(k₀)} Σ_p P_Δ(k_p) W_pc(G_Δ),
@@ -21,28 +21,28 @@
 //! dispersion in thick plates) takes a shared product-integration rule of as many points as its
 //! chirp needs ([`Integration::dense`]). Groups whose fringe is invisible in every channel are dropped; orders
 //! beyond the coherent ones are the incoherent tail of [`crate::plate::paths`]. The budget of
-//! every approximation: [`crate::spectral::budget`].
+//! every approximation: [`crate::quadrature::budget`].
 
+use crate::colour::weights::WeightSet;
 use crate::error::Result;
 use crate::optics::mueller;
 use crate::plate::paths::{ClassAmplitudes, Lobe};
 use crate::plate::slab::{Output, SlabMueller, Want};
+use crate::quadrature::budget::{DROP, NODE_ERROR, ORDER_TAIL};
+use crate::quadrature::chebyshev;
+use crate::quadrature::fringe;
+use crate::quadrature::nodes::{self, LEVELS, MAX_NODES};
 use crate::scratch::{Pool, Pooled};
 use crate::spectral::amplitudes::traversal_q;
-use crate::spectral::budget::{DROP, NODE_ERROR, ORDER_TAIL};
-use crate::spectral::fringe;
 use crate::spectral::layout::{self, Group, Layout, MAX_ORDER};
-use crate::spectral::nodes::{self, LEVELS, MAX_NODES};
-use crate::spectral::shared;
 use crate::spectral::survey::Survey;
-use crate::spectral::weights::WeightSet;
 use nalgebra::{Matrix2, Matrix4};
 use num_complex::Complex64 as C64;
 use std::f64::consts::TAU;
 
 /// How the path-class method integrates a plate.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Plan {
+pub struct Orders {
     /// Highest coherent order (the rest is the incoherent tail).
     pub order: usize,
     /// Pairs of different orders can be visible (a round trip within the coherence of the
@@ -61,7 +61,7 @@ const PHASE_LEVEL: usize = 4;
 /// `ρ^{2n}`), at most [`MAX_ORDER`] (beyond, the tail takes the rest: plates near grazing
 /// incidence, where the round trip reflects nearly everything; docs/physics.md §4, "Known
 /// limitations", gives that error as measured). `None` if the orders do not converge (`ρ ≥ 1`).
-pub fn plan(s: &Survey, set: WeightSet) -> Option<Plan> {
+pub fn plan(s: &Survey, set: WeightSet) -> Option<Orders> {
     let rho = s.rho;
     // `ρ ≥ 1` or NaN: the orders do not converge.
     if rho.is_nan() || rho >= 1.0 {
@@ -90,7 +90,7 @@ pub fn plan(s: &Survey, set: WeightSet) -> Option<Plan> {
         })
         .unwrap_or(MAX_ORDER);
     let cross_orders = 2.0 * rho * sum * rule.visibility_beyond(nearest.max(0.0)) >= DROP;
-    Some(Plan {
+    Some(Orders {
         order,
         cross_orders,
         tail_strength: rho.powi(2 * (order as i32 + 1)) / (1.0 - rho * rho),
@@ -181,7 +181,7 @@ struct TraversalPhases {
 }
 
 impl TraversalPhases {
-    fn fill(&mut self, s: &Survey, rule: &shared::Rule, series: &TraversalSeries) {
+    fn fill(&mut self, s: &Survey, rule: &chebyshev::Rule, series: &TraversalSeries) {
         let (k0, a) = fringe::band();
         let d = s.plate.thickness_nm;
         let at = |c: &[[f64; PHASE_NODES]; 4], k: f64| -> [f64; 4] {
@@ -224,9 +224,9 @@ fn work() -> Pooled<Work> {
 }
 
 /// `∫ w_c M` for the channels of `set` by `plan` (module docs).
-pub fn integrate(
+pub fn channels(
     s: &Survey,
-    plan: &Plan,
+    plan: &Orders,
     set: WeightSet,
     want: Want,
     output: Output,
@@ -363,7 +363,7 @@ pub fn integrate(
 #[allow(clippy::too_many_arguments)]
 fn select(
     s: &Survey,
-    plan: &Plan,
+    plan: &Orders,
     set: WeightSet,
     l: usize,
     layout: &Layout,
@@ -576,7 +576,7 @@ impl Integration<'_, '_> {
 
     /// A group whose residual phase no level resolves (the chirp of a thick, strongly
     /// dispersive plate), on a shared product-integration rule of the weights
-    /// ([`crate::spectral::shared`]): `ω_ic = Σ_j W_jc e^{iφ(k_j) − α(k_j)} L_i(k_j)` with its
+    /// ([`crate::quadrature::chebyshev`]): `ω_ic = Σ_j W_jc e^{iφ(k_j) − α(k_j)} L_i(k_j)` with its
     /// phase `φ(k) = k d Δ·Re Q(k)` and attenuation `α(k) = k d Σ·Im Q(k)` from their Chebyshev
     /// interpolants through the exact values at the nodes of [`PHASE_LEVEL`] (`Q` is analytic
     /// around the band: they converge geometrically) and its amplitude interpolated between its
@@ -607,14 +607,14 @@ impl Integration<'_, '_> {
             })
             .fold(0.0, f64::max);
         let tolerance = NODE_ERROR / p.strength.max(1e-300);
-        let points = shared::LADDER
+        let points = chebyshev::LADDER
             .iter()
             .copied()
             .find(|&n| {
-                shared::rule(self.set, n).error_at(shared::SPAN_MARGIN * fastest) <= tolerance
+                chebyshev::rule(self.set, n).error_at(chebyshev::SPAN_MARGIN * fastest) <= tolerance
             })
-            .unwrap_or(shared::LADDER[shared::LADDER.len() - 1]);
-        let rule = shared::rule(self.set, points);
+            .unwrap_or(chebyshev::LADDER[chebyshev::LADDER.len() - 1]);
+        let rule = chebyshev::rule(self.set, points);
         let i = match chirped.iter().position(|t| t.points == rule.nodes.len()) {
             Some(i) => i,
             None => {
@@ -631,7 +631,7 @@ impl Integration<'_, '_> {
             chirped[i].fill(self.s, rule, series);
         }
         let table = &chirped[i];
-        let bases = shared::node_basis(self.set, points, p.amplitude_level);
+        let bases = chebyshev::node_basis(self.set, points, p.amplitude_level);
         let n = LEVELS[p.amplitude_level];
         let rows = rule.nodes.iter().zip(bases);
         for (((_, w), basis), (phi, alpha)) in rows.zip(table.phase.iter().zip(&table.attenuation))

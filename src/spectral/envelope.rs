@@ -1,7 +1,7 @@
 //! The plate over the channels of a weight set with every internal order in closed form: the
 //! exact plate's coherency sampled at the Chebyshev–Lobatto nodes of the band, whole or split
 //! into families of pairs of orders a fixed number of round trips apart, each family's fast
-//! common oscillation integrated exactly by the fringe rules of [`crate::spectral::fringe`].
+//! common oscillation integrated exactly by the fringe rules of [`crate::quadrature::fringe`].
 //!
 //! **Families of orders.** With the internal round trip `D = r₃ P↑ r₂ P↓` and a reference phase
 //! `φ(k) = G (k − k₀)` per round trip (`G` the round trip's middle group path), write
@@ -18,11 +18,11 @@
 //! `conj(r₁) ⊗ Ṽ D̃^{Δ−1} t₁`. `F_Δ` keeps only what differs from the reference within a
 //! family (the o/e split, dispersion, absorption): slow where this method is chosen, so each
 //! family integrates as `∫ w_c e^{iΔφ} F_Δ = Σ_i W_ic(ΔG) F_Δ(k_i)` on the nodes `k_i`
-//! ([`crate::spectral::fringe`]). By Cayley–Hamilton `D̃^Δ = α_Δ I + β_Δ D̃`, so every family at a
+//! ([`crate::quadrature::fringe`]). By Cayley–Hamilton `D̃^Δ = α_Δ I + β_Δ D̃`, so every family at a
 //! node comes from two solves with one factorisation, `Y₀ = (I − D̄̃ ⊗ D̃)⁻¹ (t̄₁ ⊗ t₁)` and
 //! `Y₁` with `D̃ t₁`: per channel `Σ_Δ W_ic(ΔG) F_Δ(k_i) = (X̄ ⊗ X)(α Y₀ + β Y₁)` with
 //! `α = Σ_Δ W_ic(ΔG) α_Δ` (and `β` likewise). Families beyond the last visible one
-//! ([`crate::spectral::fringe::FringeRule::visibility_beyond`]) are dropped; the rest is exact
+//! ([`crate::quadrature::fringe::FringeRule::visibility_beyond`]) are dropped; the rest is exact
 //! up to the interpolation of each family's slow factor on the nodes.
 //!
 //! **The whole plate.** Where the plate's spectrum is slow altogether (thin plates, a plate of
@@ -33,18 +33,18 @@
 //! `δ` in group path and `x` in attenuation across the half band `a` has a slow factor varying
 //! as `e^{i n (δ a + x) t}`; its weight is at most `ρ^s` (`s` the pair's round trips, `ρ` the
 //! survey's bound on a round trip's norm). The level is the coarsest whose
-//! [`crate::spectral::budget::interpolation_error`], summed over the pairs with these weights,
-//! meets [`crate::spectral::budget::NODE_ERROR`].
+//! [`crate::quadrature::budget::interpolation_error`], summed over the pairs with these weights,
+//! meets [`crate::quadrature::budget::NODE_ERROR`].
 
 use crate::cmath;
+use crate::colour::weights::WeightSet;
 use crate::error::{Error, Result};
 use crate::optics::mueller;
 use crate::plate::slab::{Output, SlabBlocks, SlabMueller, Want};
-use crate::spectral::budget::{DROP, NODE_ERROR};
-use crate::spectral::fringe;
-use crate::spectral::nodes::{self, LEVELS};
+use crate::quadrature::budget::{DROP, NODE_ERROR};
+use crate::quadrature::fringe;
+use crate::quadrature::nodes::{self, LEVELS};
 use crate::spectral::survey::Survey;
-use crate::spectral::weights::WeightSet;
 use nalgebra::{Matrix2, Matrix4};
 use num_complex::Complex64 as C64;
 use std::f64::consts::TAU;
@@ -55,7 +55,7 @@ pub const MAX_FAMILIES: usize = 48;
 
 /// How the envelope method integrates a plate.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Plan {
+pub struct Envelope {
     /// The level of the nodes (index into [`LEVELS`]).
     pub level: usize,
     /// The families of orders split off; `None`: the whole plate at the nodes.
@@ -239,14 +239,14 @@ impl Growth {
 /// The plan for `survey` over `set`: the whole plate or families of orders, whichever needs
 /// fewer node evaluations (a family split costs about three evaluations of the plate per node);
 /// `None` if neither resolves the plate on the finest level.
-pub fn plan(s: &Survey, set: WeightSet) -> Option<Plan> {
+pub fn plan(s: &Survey, set: WeightSet) -> Option<Envelope> {
     let rates = Rates::of(s)?;
     let first = s.amplitudes.level;
     // The whole plate: every family, a round trip's whole group path in each.
     let full = rates.round_trip.abs() + rates.chirp;
     let whole = rates
         .coarsest(first, |g| g.families(full, None))
-        .map(|level| Plan {
+        .map(|level| Envelope {
             level,
             families: None,
         });
@@ -256,7 +256,7 @@ pub fn plan(s: &Survey, set: WeightSet) -> Option<Plan> {
     let split = last_family(&rates, set).and_then(|last| {
         rates
             .coarsest(first, |g| g.families(rates.chirp, Some(last)))
-            .map(|level| Plan {
+            .map(|level| Envelope {
                 level,
                 families: Some(Families {
                     group_path: rates.round_trip,
@@ -264,7 +264,7 @@ pub fn plan(s: &Survey, set: WeightSet) -> Option<Plan> {
                 }),
             })
     });
-    let cost = |p: &Plan| LEVELS[p.level] as f64 * if p.families.is_some() { 3.0 } else { 1.0 };
+    let cost = |p: &Envelope| LEVELS[p.level] as f64 * if p.families.is_some() { 3.0 } else { 1.0 };
     match (whole, split) {
         (Some(w), Some(f)) => Some(if cost(&f) < cost(&w) { f } else { w }),
         (w, f) => w.or(f),
@@ -318,9 +318,9 @@ fn last_family(r: &Rates, set: WeightSet) -> Option<usize> {
 }
 
 /// `∫ w_c M` for the channels of `set` by `plan` (module docs).
-pub fn integrate(
+pub fn channels(
     s: &Survey,
-    plan: &Plan,
+    plan: &Envelope,
     set: WeightSet,
     want: Want,
     output: Output,

@@ -6,39 +6,29 @@
 //!   ([`crate::plate::etalon`]): exact in closed form at one wavelength and over every
 //!   Gaussian.
 //! * Any other plate is the general slab ([`crate::plate::slab`]) at one wavelength; over a
-//!   band, the closed forms and quadratures of [`crate::spectral::integrate`]; over a channel
-//!   set, the path-class fringe integration of [`crate::spectral::channels`] (held to the
+//!   band, the closed forms and quadratures of [`crate::spectral::gaussian`]; over a channel
+//!   set, the path-class fringe integration of [`crate::colour::channels`] (held to the
 //!   perceptual budget stated there), or, on request or where that method declines (more
 //!   coherent orders than it sums: thin plates of high index near grazing incidence), the exact
 //!   rule of [`integrate_set_exact`] (every approximation below 1e-5 of the fitted weights).
 
 use crate::band::Gaussian;
+use crate::colour::weights::{gaussians, WeightSet};
 use crate::error::Result;
 use crate::optics::frame::PlaneFrame;
 use crate::plate::etalon::Etalon;
 use crate::plate::slab::{Output, SlabMueller, SlabOptics, Want};
 use crate::plate::Plate;
+use crate::quadrature::Accuracy;
 use crate::spectral::classes;
 use crate::spectral::dense;
 use crate::spectral::envelope;
-use crate::spectral::integrate::{etalon_sum, integrate, integrate_set_exact};
+use crate::spectral::gaussian::{self, channels_exact, etalon_sum};
+use crate::spectral::pointwise;
 use crate::spectral::route::{self, Route};
-use crate::spectral::shared;
 use crate::spectral::survey::Survey;
-use crate::spectral::weights::{gaussians, WeightSet};
 use num_complex::Complex64 as C64;
 use std::cell::OnceCell;
-
-/// How exactly a channel set is integrated.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Accuracy {
-    /// The perceptual budget of [`crate::spectral::channels`] (mean CIEDE2000 0.1, worst 0.5
-    /// against the tabulated weights, measured in `tests/spectral_rgb.rs`): what renders use.
-    Perceptual,
-    /// Every approximation below 1e-5 of the fitted weights (the rule the perceptual one is
-    /// checked against, and the calculator's `"method": "exact"`).
-    Exact,
-}
 
 /// A plate at one incidence, with the model that serves it.
 pub struct PlateModel<'a> {
@@ -108,7 +98,7 @@ impl<'a> PlateModel<'a> {
         {
             return Ok(m);
         }
-        integrate(self.plate, &self.frame, self.beta, band, want, output)
+        gaussian::band(self.plate, &self.frame, self.beta, band, want, output)
     }
 
     /// Over the three channels of `set`, to `accuracy`.
@@ -125,11 +115,11 @@ impl<'a> PlateModel<'a> {
             return Ok([one(0)?, one(1)?, one(2)?]);
         }
         if accuracy == Accuracy::Exact {
-            return integrate_set_exact(self.plate, &self.frame, self.beta, set, want, output);
+            return channels_exact(self.plate, &self.frame, self.beta, set, want, output);
         }
         let survey = Survey::new(self.plate, self.frame, self.beta)?;
         match route::choose(&survey, set)? {
-            Route::Evanescent(points) => shared::quadrature(
+            Route::Evanescent(points) => pointwise::channels(
                 self.plate,
                 &self.frame,
                 self.beta,
@@ -138,9 +128,9 @@ impl<'a> PlateModel<'a> {
                 want,
                 output,
             ),
-            Route::Dense(points) => dense::integrate(&survey, points, set, want, output),
-            Route::Envelope(plan) => envelope::integrate(&survey, &plan, set, want, output),
-            Route::Classes(plan) => classes::integrate(&survey, &plan, set, want, output),
+            Route::Dense(points) => dense::channels(&survey, points, set, want, output),
+            Route::Envelope(plan) => envelope::channels(&survey, &plan, set, want, output),
+            Route::Classes(plan) => classes::channels(&survey, &plan, set, want, output),
         }
     }
 }

@@ -1,7 +1,7 @@
 //! A narrow band through a birefringent plate in closed form: the plate as a matrix etalon.
 //!
 //! Across a narrow band (σ ≪ μ) the interface amplitudes barely change (they are taken at the
-//! centre, as the pair sums of [`crate::spectral::integrate`] do) and each traversal of the
+//! centre, as the pair sums of [`crate::spectral::gaussian`] do) and each traversal of the
 //! layer in mode `j` has the phase `μ d Q_j + κ d G_j` at `k = μ + κ` (`G_j = Q_j + μ Q_j'`
 //! its group index). Write `G_j = ḡ + δ_j`: the common part `ḡ` is the fast phase of the
 //! internal round trips, `h = exp(2 i κ d ḡ)` per round trip; the residuals `δ_j` (the
@@ -32,7 +32,7 @@
 use crate::band::Gaussian;
 use crate::cmath;
 use crate::plate::slab::{SlabOptics, Want};
-use crate::spectral::hermite;
+use crate::quadrature::hermite;
 use nalgebra::{Matrix2, Matrix4};
 use num_complex::Complex64 as C64;
 

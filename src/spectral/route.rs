@@ -1,31 +1,32 @@
 //! Which method integrates a plate over a weight set's channels: decided once, here, from the
 //! survey's invariants ([`Survey`]), before any method starts.
 
+use crate::colour::weights::WeightSet;
 use crate::error::Result;
 use crate::plate::paths::Lobe;
+use crate::quadrature::chebyshev::LADDER;
+use crate::quadrature::fringe;
+use crate::quadrature::nodes::LEVELS;
 use crate::spectral::classes;
 use crate::spectral::envelope;
-use crate::spectral::fringe;
 use crate::spectral::layout;
-use crate::spectral::nodes::LEVELS;
-use crate::spectral::shared;
+use crate::spectral::pointwise;
 use crate::spectral::survey::Survey;
-use crate::spectral::weights::WeightSet;
 
 /// The method that serves a plate at one incidence.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Route {
     /// A wave turns evanescent inside the band (its phase has a branch point there): the exact
     /// plate, solved at every point of a shared product-integration rule of this many points
-    /// ([`crate::spectral::shared`]).
+    /// ([`crate::quadrature::chebyshev`]).
     Evanescent(usize),
     /// The exact plate on a shared rule of this many points, its blocks interpolated from the
     /// amplitude nodes ([`crate::spectral::dense`]).
     Dense(usize),
     /// Every order in closed form ([`crate::spectral::envelope`]).
-    Envelope(envelope::Plan),
+    Envelope(envelope::Envelope),
     /// Pairs of path classes ([`crate::spectral::classes`]).
-    Classes(classes::Plan),
+    Classes(classes::Orders),
 }
 
 /// The route of `survey` over `set` (module docs): the cheapest of the methods that serve the
@@ -45,8 +46,10 @@ pub enum Route {
 ///   rutile).
 pub fn choose(survey: &Survey, set: WeightSet) -> Result<Route> {
     let points = || -> Result<usize> {
-        Ok(shared::plan(survey.plate, &survey.frame, survey.beta, set)?
-            .unwrap_or(shared::LADDER[shared::LADDER.len() - 1]))
+        Ok(
+            pointwise::exact_points(survey.plate, &survey.frame, survey.beta, set)?
+                .unwrap_or(LADDER[LADDER.len() - 1]),
+        )
     };
     if survey.loss.is_none() {
         return Ok(Route::Evanescent(points()?));
@@ -83,7 +86,7 @@ const CHIRP: f64 = 14.0;
 /// True if the path classes serve the plate: thick (no pair of different orders visible), or
 /// at most [`CROSS_ORDERS`] orders whose fringes' chirp (the spread of a traversal's group path
 /// across the band, over the traversals of a pair) stays within [`CHIRP`].
-fn classes_serve(s: &Survey, c: &classes::Plan) -> bool {
+fn classes_serve(s: &Survey, c: &classes::Orders) -> bool {
     if !c.cross_orders {
         return true;
     }
@@ -109,7 +112,7 @@ const COST_PHASE: f64 = 1000.0;
 const COST_CLASS_NODE: f64 = 1500.0;
 const COST_PAIR: f64 = 30.0;
 
-fn envelope_cost(s: &Survey, p: &envelope::Plan) -> f64 {
+fn envelope_cost(s: &Survey, p: &envelope::Envelope) -> f64 {
     let n = LEVELS[p.level] as f64;
     let per = if p.families.is_some() {
         COST_FAMILY_NODE
@@ -124,7 +127,7 @@ fn envelope_cost(s: &Survey, p: &envelope::Plan) -> f64 {
     n * per + phases
 }
 
-fn classes_cost(s: &Survey, p: &classes::Plan) -> f64 {
+fn classes_cost(s: &Survey, p: &classes::Orders) -> f64 {
     let orders = (p.order + 1) as f64;
     let pairs: usize = [Lobe::Reflection, Lobe::Transmission]
         .iter()

@@ -8,10 +8,10 @@ use crate::cmath::spectral_norm;
 use crate::error::Result;
 use crate::optics::frame::PlaneFrame;
 use crate::plate::Plate;
+use crate::quadrature::budget::ATTENUATED;
+use crate::quadrature::fringe;
+use crate::quadrature::nodes::{self, SPAN};
 use crate::spectral::amplitudes::{least_attenuation, Amplitudes};
-use crate::spectral::budget::ATTENUATED;
-use crate::spectral::fringe;
-use crate::spectral::nodes::{self, SPAN};
 use num_complex::Complex64 as C64;
 use std::f64::consts::TAU;
 

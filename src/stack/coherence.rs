@@ -38,7 +38,7 @@ use nalgebra::{Matrix2, Matrix4};
 use num_complex::Complex64 as C64;
 
 /// How each layer of a stack is treated for one spectrum (decided by
-/// [`crate::stack::plan::Plan`]).
+/// [`crate::stack::plan::StackPlan`]).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Coherence {
     /// Per layer: its round trips are incoherent.

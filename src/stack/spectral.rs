@@ -1,10 +1,10 @@
 //! A stack integrated over colour channels and narrow bands (docs/physics.md §8).
 //!
 //! **Channels** (a weight set's three Gaussian fits): the model of [`crate::stack::coherence`]
-//! under the set's [`Plan`] (thick layers' round trips incoherent) evaluated at the Chebyshev
-//! points of the shared product-integration rule [`shared::rule`], whose point count
-//! [`shared::points`] takes from the plan's frequencies: every oscillation of amplitude `a` is
-//! integrated to `a · error ≤ 1e-5` of the light ([`shared::TOLERANCE`]), at most 1024 points
+//! under the set's [`StackPlan`] (thick layers' round trips incoherent) evaluated at the Chebyshev
+//! points of the shared product-integration rule [`chebyshev::rule`], whose point count
+//! [`chebyshev::points`] takes from the plan's frequencies: every oscillation of amplitude `a` is
+//! integrated to `a · error ≤ 1e-5` of the light ([`chebyshev::TOLERANCE`]), at most 1024 points
 //! (a stack that needs more, rare once invisible cross terms are dropped, takes 1024). Each
 //! point serves all three channels. A dispersive stack's interface blocks are interpolated
 //! across the rule's support ([`Interpolant`]), its phases computed exactly at every point.
@@ -12,7 +12,7 @@
 //! **A narrow band** (one Gaussian `N(μ, σ)`, the plugins' `filter_bandwidth`): the same
 //! model under the band's plan, by composite 8-point Gauss–Legendre panels over `μ ± 6.5σ` with
 //! at most half a period of the fastest significant oscillation per panel (`a_n ≥ 1e-5`,
-//! [`shared::points`]'s amplitudes), at least 16 panels.
+//! [`chebyshev::points`]'s amplitudes), at least 16 panels.
 //!
 //! **Exact** ([`Accuracy::Exact`]): every layer coherent (the exact stack) at the Chebyshev
 //! points; refused (naming `spectrum.method`) if more than 1024 are needed.
@@ -22,17 +22,17 @@
 //! stacks): mean CIEDE2000 ≤ 0.1, worst ≤ 0.5, as for one plate.
 
 use crate::band::Gaussian;
+use crate::colour::weights::{gaussians, WeightSet};
 use crate::error::{Error, Result};
 use crate::optics::frame::PlaneFrame;
 use crate::plate::slab::{Output, SlabMueller, Want};
-use crate::spectral::hermite;
-use crate::spectral::interpolate::{self, Interpolant};
-use crate::spectral::model::Accuracy;
-use crate::spectral::shared::{self, LADDER, TOLERANCE};
-use crate::spectral::weights::{gaussians, WeightSet};
+use crate::quadrature::chebyshev::{self, LADDER, TOLERANCE};
+use crate::quadrature::hermite;
+use crate::quadrature::interpolate::{self, Interpolant};
+use crate::quadrature::Accuracy;
 use crate::stack::coherence::{self, Coherence, Prepared};
 use crate::stack::exact::{layer_q_into, StackBlocks};
-use crate::stack::plan::{layer_paths, reflectances, LayerPaths, Plan, Weight};
+use crate::stack::plan::{layer_paths, reflectances, LayerPaths, StackPlan, Weight};
 use crate::stack::Stack;
 use nalgebra::Matrix4;
 use num_complex::Complex64 as C64;
@@ -98,7 +98,7 @@ impl<'a> StackModel<'a> {
     }
 
     /// The layers' group paths at wavenumbers `ks` and the interfaces' reflectances at the
-    /// first of them: what [`Plan`]s are made of.
+    /// first of them: what [`StackPlan`]s are made of.
     pub fn paths(&self, ks: &[f64]) -> Result<(Vec<LayerPaths>, Vec<f64>)> {
         Ok((
             layer_paths(self.stack, &self.frame, self.beta, ks)?,
@@ -107,9 +107,9 @@ impl<'a> StackModel<'a> {
     }
 
     /// The plan for `weight`, the group paths taken at wavenumbers `ks`.
-    pub fn plan(&self, ks: &[f64], weight: &Weight, exact: bool) -> Result<Plan> {
+    pub fn plan(&self, ks: &[f64], weight: &Weight, exact: bool) -> Result<StackPlan> {
         let (paths, r) = self.paths(ks)?;
-        Ok(Plan::new(&paths, &r, weight, exact))
+        Ok(StackPlan::new(&paths, &r, weight, exact))
     }
 
     /// Over the Gaussian band `g` (module docs): the partially coherent model at
@@ -147,7 +147,7 @@ impl<'a> StackModel<'a> {
         output: Output,
         accuracy: Accuracy,
     ) -> Result<[SlabMueller; 3]> {
-        let (lo, hi) = shared::support(set);
+        let (lo, hi) = chebyshev::support(set);
         let bulk = (0..3)
             .flat_map(|c| gaussians(set, c).iter())
             .map(|g| g.mu + 3.0 * g.sigma)
@@ -156,8 +156,8 @@ impl<'a> StackModel<'a> {
         let exact = accuracy == Accuracy::Exact;
         let weight = Weight::of_set(set);
         let (paths, r) = self.paths(&[0.5 * (lo + hi), bulk])?;
-        let mut plan = Plan::new(&paths, &r, &weight, exact);
-        let points = |p: &Plan| shared::points(set, p.omega_1, p.omega_b, p.rho);
+        let mut plan = StackPlan::new(&paths, &r, &weight, exact);
+        let points = |p: &StackPlan| chebyshev::points(set, p.omega_1, p.omega_b, p.rho);
         // Too many coherent orders for any rule: the longest round trips become incoherent.
         while points(&plan).is_none() && !exact {
             match plan.thicken(&paths, &r, &weight) {
@@ -179,7 +179,7 @@ impl<'a> StackModel<'a> {
                 ))
             }
         };
-        let rule = shared::rule(set, points);
+        let rule = chebyshev::rule(set, points);
         self.quadrature(
             &rule.nodes,
             (rule.lo, rule.hi),
@@ -306,7 +306,7 @@ pub fn quadrature(
 
 /// The fastest oscillation (nm) of the plan whose amplitude `ρⁿ / (1 − ρ)²` after `n` round
 /// trips is at least [`TOLERANCE`] (the direct light's `ω_b` always; at most 64 round trips).
-pub fn fastest(plan: &Plan) -> f64 {
+pub fn fastest(plan: &StackPlan) -> f64 {
     let mut omega = plan.omega_b;
     if !(0.0..1.0).contains(&plan.rho) {
         return omega + 64.0 * plan.omega_1;

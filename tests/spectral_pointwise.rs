@@ -1,15 +1,17 @@
-//! The shared three-channel quadrature (`spectral::shared`, panels sized order by order) against
-//! a dense composite Gauss–Legendre rule of the exact plate (both interfaces solved at every
-//! node, no interpolation, 1024 panels over the same support; the shared rule interpolates on Chebyshev points), Mueller matrices entry by entry.
+//! The exact plate on a weight set's Chebyshev rule (`spectral::pointwise`, its points sized
+//! order by order by `quadrature::chebyshev`) against a dense composite Gauss–Legendre rule of
+//! the exact plate (both interfaces solved at every node, no interpolation, 1024 panels over the
+//! same support; the Chebyshev rule interpolates), Mueller matrices entry by entry.
 
+use birefringent::colour::weights::{gaussians, WeightSet};
 use birefringent::material::Material;
 use birefringent::optics::frame::PlaneFrame;
 use birefringent::plate::slab::Output;
 use birefringent::plate::slab::Want;
 use birefringent::plate::Plate;
-use birefringent::spectral::hermite;
-use birefringent::spectral::shared::{self, support};
-use birefringent::spectral::weights::{gaussians, WeightSet};
+use birefringent::quadrature::chebyshev::support;
+use birefringent::quadrature::hermite;
+use birefringent::spectral::pointwise;
 use birefringent::C64;
 use nalgebra::Matrix4;
 use std::f64::consts::TAU;
@@ -67,13 +69,13 @@ fn shared_rule_matches_a_dense_rule_of_the_exact_plate() {
         let frame = PlaneFrame::from_azimuth(rng.range(0.0, TAU));
         let beta = C64::new(rng.range(0.0, 0.95), 0.0);
         let set = WeightSet::ALL[i % 3];
-        let Some(points) = shared::plan(&plate, &frame, beta, set).unwrap() else {
+        let Some(points) = pointwise::exact_points(&plate, &frame, beta, set).unwrap() else {
             declined += 1;
             continue;
         };
         planned += 1;
         point_counts.push(points);
-        let got = shared::quadrature(
+        let got = pointwise::channels(
             &plate,
             &frame,
             beta,

@@ -22,11 +22,12 @@
 //! Gaussian (σ ≤ [`NARROW_BAND`] μ) through any plate is the matrix etalon of
 //! [`crate::spectral::narrow`] where its residual phases are resolved by a few nodes. The
 //! shared quadrature of [`integrate_set`] interpolates a dispersive plate's interface blocks
-//! across the band ([`crate::spectral::interpolate`]) and sizes its rule order by order
-//! ([`crate::spectral::shared`]).
+//! across the band ([`crate::quadrature::interpolate`]) and sizes its rule order by order
+//! ([`crate::quadrature::chebyshev`]).
 
 use crate::band::Gaussian;
 use crate::cmath;
+use crate::colour::weights::{gaussians, WeightSet};
 use crate::error::{Error, Result};
 use crate::optics::frame::PlaneFrame;
 use crate::optics::mueller;
@@ -34,11 +35,10 @@ use crate::plate::etalon::Etalon;
 use crate::plate::paths::{PathClass, PathExpansion};
 use crate::plate::slab::{Output, SlabMueller, SlabOptics, Want};
 use crate::plate::Plate;
+use crate::quadrature::hermite;
 use crate::spectral::group::{dispersion, group_round_trips, Dispersion};
-use crate::spectral::hermite;
 use crate::spectral::narrow;
-use crate::spectral::shared;
-use crate::spectral::weights::{gaussians, WeightSet};
+use crate::spectral::pointwise;
 use nalgebra::{Matrix2, Matrix4};
 use num_complex::Complex64 as C64;
 
@@ -80,7 +80,7 @@ pub const HERMITE_LIMIT: f64 = 10.0;
 
 /// Integrates the plate's reflection/transmission Mueller matrices over the band
 /// `Σ_j a_j G(k; μ_j, σ_j)` (Mitsuba's convention, s/p frames, power fractions).
-pub fn integrate(
+pub fn band(
     plate: &Plate,
     frame: &PlaneFrame,
     beta: C64,
@@ -88,11 +88,11 @@ pub fn integrate(
     want: Want,
     output: Output,
 ) -> Result<SlabMueller> {
-    integrate_with(plate, frame, beta, band, want, output, Method::Auto)
+    band_with(plate, frame, beta, band, want, output, Method::Auto)
 }
 
 /// [`integrate`] with a forced [`Method`] (for tests of the shortcuts and benchmarks).
-pub fn integrate_with(
+pub fn band_with(
     plate: &Plate,
     frame: &PlaneFrame,
     beta: C64,
@@ -345,10 +345,10 @@ fn quadrature_rule(
 /// channels of a weight set at once, every approximation below 1e-5 of the fitted weights:
 /// when the plate's spectrum varies slowly over the whole visible range (thin plates: few
 /// oscillations of its significant orders across the weights' support), one product-integration
-/// rule of the exact plate serves every Gaussian of every channel ([`shared`]: at most 1024
+/// rule of the exact plate serves every Gaussian of every channel ([`pointwise`]: at most 1024
 /// plate evaluations instead of a quadrature per Gaussian); otherwise each channel goes through
 /// [`integrate`].
-pub fn integrate_set_exact(
+pub fn channels_exact(
     plate: &Plate,
     frame: &PlaneFrame,
     beta: C64,
@@ -356,10 +356,10 @@ pub fn integrate_set_exact(
     want: Want,
     output: Output,
 ) -> Result<[SlabMueller; 3]> {
-    match shared::plan(plate, frame, beta, set)? {
-        Some(points) => shared::quadrature(plate, frame, beta, set, points, want, output),
+    match pointwise::exact_points(plate, frame, beta, set)? {
+        Some(points) => pointwise::channels(plate, frame, beta, set, points, want, output),
         None => {
-            let one = |c: usize| integrate(plate, frame, beta, gaussians(set, c), want, output);
+            let one = |c: usize| band(plate, frame, beta, gaussians(set, c), want, output);
             Ok([one(0)?, one(1)?, one(2)?])
         }
     }
@@ -438,59 +438,4 @@ fn band_sum(
             m
         }
     }
-}
-
-/// Most plate evaluations [`quadrature`] accepts.
-pub const QUADRATURE_MAX: usize = 10_000_000;
-
-/// Reference: `∫ w(λ) M(λ) dλ` of the exact slab by the trapezoid rule on `[lo, hi]` with
-/// `step_nm`, `weight` per nm (normalise it yourself). Slow; for validation.
-pub fn quadrature(
-    plate: &Plate,
-    frame: &PlaneFrame,
-    beta: C64,
-    weight: impl Fn(f64) -> f64,
-    (lo, hi): (f64, f64),
-    step_nm: f64,
-    want: Want,
-) -> Result<SlabMueller> {
-    if !(step_nm > 0.0 && step_nm.is_finite()) {
-        return Err(Error::new("step_nm", "must be > 0"));
-    }
-    let count = ((hi - lo) / step_nm).ceil().max(1.0);
-    if count.is_nan() || count > QUADRATURE_MAX as f64 {
-        return Err(Error::new(
-            "step_nm",
-            format!(
-                "too small: {count:.3e} plate evaluations over [{lo}, {hi}] nm (at most {QUADRATURE_MAX:.0e}; minutes of run time)"
-            ),
-        ));
-    }
-    let n = count as usize;
-    let h = (hi - lo) / n as f64;
-    let fixed = if plate.is_dispersive() {
-        None
-    } else {
-        Some(plate.at(0.5 * (lo + hi))?.optics(frame, beta)?)
-    };
-    let mut r = Matrix4::zeros();
-    let mut t = Matrix4::zeros();
-    for j in 0..=n {
-        let lambda = lo + h * j as f64;
-        let w = weight(lambda) * if j == 0 || j == n { 0.5 * h } else { h };
-        if w == 0.0 {
-            continue;
-        }
-        let optics = match fixed {
-            Some(o) => o,
-            None => plate.at(lambda)?.optics(frame, beta)?,
-        };
-        let m = optics.mueller(lambda, want)?;
-        r += m.r.unwrap_or_default() * w;
-        t += m.t.unwrap_or_default() * w;
-    }
-    Ok(SlabMueller {
-        r: want.reflection.then_some(r),
-        t: want.transmission.then_some(t),
-    })
 }

@@ -1,5 +1,6 @@
-//! One quadrature of the exact plate shared by the three channels of a weight set, for plates
-//! whose spectrum varies slowly over the visible range (thin plates and films).
+//! The product-integration rule of a weight set on Chebyshev points: one rule shared by the
+//! three channels, for a spectrum that varies slowly over the visible range (thin plates and
+//! films, stacks; the plate's use: [`crate::spectral::pointwise`]).
 //!
 //! `∫ w_c(k) M(k) dk` for the channels `c` of a fitted weight set ([`gaussians`]) by product
 //! integration on the weights' support `[lo, hi]` (every Gaussian's `μ ± 6σ`): `M` is sampled
@@ -7,8 +8,7 @@
 //! integrated against each weight exactly, `Σ_j W_cj M(k_j)` with
 //! `W_cj = (1/N) Σ_{n<N} (2 − δ_n0) T_n(t_j) μ_cn` and the weight's Chebyshev moments
 //! `μ_cn = ∫ w_c(k) T_n(t(k)) dk` (computed once, in `θ = arccos t`, where every integrand is
-//! smooth). Each point solves the plate once (its interface blocks interpolated across the
-//! band, [`BlockInterpolant`]) and serves all three channels. Interpolation on Chebyshev points
+//! smooth). Each point serves all three channels. Interpolation on Chebyshev points
 //! resolves an oscillation of `Φ` radians across the support with about `Φ/2` points, and the
 //! moments take the weights' own shape exactly; a composite Gauss–Legendre rule needs more
 //! nodes for both (at the same tolerance, 1e-7, the random plates of `tests/spectral_shared.rs`
@@ -32,24 +32,16 @@
 //! they are computed once per (set, rung of [`LADDER`]) and kept, with the rule's error table.
 
 use crate::band::Gaussian;
-use crate::error::Result;
-use crate::optics::frame::PlaneFrame;
-use crate::plate::slab::Output;
-use crate::plate::slab::{SlabBlocks, SlabMueller, Want};
-use crate::plate::Plate;
-use crate::spectral::group::{dispersion, group_round_trips, group_splitting};
-use crate::spectral::hermite;
-use crate::spectral::interpolate::BlockInterpolant;
-use crate::spectral::nodes::{self, LEVELS, MAX_NODES};
-use crate::spectral::weights::{gaussians, WeightSet};
-use nalgebra::Matrix4;
+use crate::colour::weights::{gaussians, WeightSet};
+use crate::quadrature::hermite;
+use crate::quadrature::nodes::{self, LEVELS, MAX_NODES};
 use num_complex::Complex64 as C64;
 use std::f64::consts::TAU;
 use std::sync::OnceLock;
 
 /// Largest error (absolute, in units of the light carried by the direct paths) the rule may make
 /// on any oscillation: 1/200 of the fitted weights' own error bound (the L1 norm of the fit
-/// residual, 1.7e-3 to 2.8e-3 per channel, [`crate::spectral::weights::fourier_error_bound`])
+/// residual, 1.7e-3 to 2.8e-3 per channel, [`crate::colour::weights::fourier_error_bound`])
 /// and a thousand times below a visible difference (a CIEDE2000 of 1 is ~1e-2 of the signal).
 pub const TOLERANCE: f64 = 1e-5;
 
@@ -135,8 +127,8 @@ impl Rule {
     }
 }
 
-/// The Lagrange basis of the nodes of `level` ([`crate::spectral::nodes`], on the visible band
-/// of [`crate::spectral::fringe::band`]) at every point of the rule of `set` with `points`
+/// The Lagrange basis of the nodes of `level` ([`crate::quadrature::nodes`], on the visible band
+/// of [`crate::quadrature::fringe::band`]) at every point of the rule of `set` with `points`
 /// points (rounded up to a rung of [`LADDER`]): `basis[j][i]` for point `j` and node `i`,
 /// computed once.
 pub fn node_basis(set: WeightSet, points: usize, level: usize) -> &'static [[f64; MAX_NODES]] {
@@ -150,7 +142,7 @@ pub fn node_basis(set: WeightSet, points: usize, level: usize) -> &'static [[f64
         .unwrap_or(LADDER.len() - 1);
     let level = level.min(LEVELS.len() - 1);
     BASES[set.index()][rung][level].get_or_init(|| {
-        let (k0, a) = crate::spectral::fringe::band();
+        let (k0, a) = crate::quadrature::fringe::band();
         let x = &nodes::level(level).nodes;
         let mut basis = [C64::new(0.0, 0.0); MAX_NODES];
         rule(set, points)
@@ -259,37 +251,6 @@ fn normal_pdf(k: f64, g: &Gaussian) -> f64 {
     (-0.5 * z * z).exp() / (g.sigma * TAU.sqrt())
 }
 
-/// The number of points the shared quadrature needs for this plate and weight set (module docs), or
-/// `None` if the plate's spectrum oscillates too fast for one shared rule (then each Gaussian
-/// is integrated on its own).
-pub fn plan(plate: &Plate, frame: &PlaneFrame, beta: C64, set: WeightSet) -> Result<Option<usize>> {
-    let (lo, hi) = support(set);
-    // The round trip's norm, its fastest group path and the largest group path difference of
-    // the modes, at the centre and at the short end of the weights' bulk (`μ + 3σ` of the
-    // bluest Gaussian: dispersion is steepest there; beyond, that Gaussian is below 1.1 % of
-    // its peak, and the dispersion fits of some crystals, extrapolated below their data, grow
-    // without physical meaning towards the support's end; the test against a dense rule of the
-    // exact plate covers the whole support).
-    let bulk = (0..3)
-        .flat_map(|c| gaussians(set, c).iter())
-        .map(|g| g.mu + 3.0 * g.sigma)
-        .fold(0.0, f64::max)
-        .min(hi);
-    let (mut rho, mut trip, mut split) = (0.0f64, 0.0f64, 0.0f64);
-    for k in [0.5 * (lo + hi), bulk] {
-        let optics = plate.at(TAU / k)?.optics(frame, beta)?;
-        let (pd, pu) = optics.propagation(TAU / k);
-        rho = rho.max(crate::cmath::spectral_norm(
-            &(optics.top.r_below() * pu * optics.bottom.r_above() * pd),
-        ));
-        let disp = dispersion(plate, frame, beta, k)?;
-        trip = trip.max(group_round_trips(&optics, &disp, k).1);
-        split = split.max(group_splitting(&optics, &disp, k));
-    }
-    let d = plate.thickness_nm;
-    Ok(points(set, d * trip, d * split, rho))
-}
-
 /// The smallest rung of [`LADDER`] whose rule integrates oscillations of amplitude 1 up to
 /// `omega_b` and of amplitude `a_n` up to `n omega_1 + omega_b` to [`TOLERANCE`] (module docs).
 pub fn points(set: WeightSet, omega_1: f64, omega_b: f64, rho: f64) -> Option<usize> {
@@ -324,57 +285,6 @@ pub fn points(set: WeightSet, omega_1: f64, omega_b: f64, rho: f64) -> Option<us
         .copied()
         .filter(|&p| enough(p))
         .or_else(|| LADDER.iter().copied().find(|&p| enough(p)))
-}
-
-/// `∫ w_c(k) M(k) dk` for the three channels of `set` with the shared rule of `points` points
-/// (module docs).
-pub fn quadrature(
-    plate: &Plate,
-    frame: &PlaneFrame,
-    beta: C64,
-    set: WeightSet,
-    points: usize,
-    want: Want,
-    output: Output,
-) -> Result<[SlabMueller; 3]> {
-    let rule = rule(set, points);
-    // The blocks at each node: fixed without dispersion; else interpolated across the band
-    // (checked; exact at every node where the interpolant is refused).
-    let exact =
-        |k: f64| -> Result<SlabBlocks> { Ok(plate.at(TAU / k)?.optics(frame, beta)?.blocks()) };
-    let centre = 0.5 * (rule.lo + rule.hi);
-    let fixed = if plate.is_dispersive() {
-        None
-    } else {
-        Some(exact(centre)?)
-    };
-    let interpolant = match fixed {
-        Some(_) => None,
-        None => BlockInterpolant::new(rule.lo, rule.hi, plate.thickness_nm, &exact)?,
-    };
-    let mut acc = [[Matrix4::zeros(); 2]; 3];
-    for &(k, w) in &rule.nodes {
-        let blocks = match (fixed, &interpolant) {
-            (Some(b), _) => b,
-            (None, Some(f)) => f.at(k),
-            (None, None) => exact(k)?,
-        };
-        let m = blocks.mueller(TAU / k, want)?;
-        let lobes = [m.r, m.t];
-        for (sums, wc) in acc.iter_mut().zip(w) {
-            for (sum, lobe) in sums.iter_mut().zip(&lobes) {
-                match (lobe, output) {
-                    (Some(x), Output::Mueller) => *sum += x * wc,
-                    (Some(x), Output::Intensity) => sum[(0, 0)] += x[(0, 0)] * wc,
-                    (None, _) => {}
-                }
-            }
-        }
-    }
-    Ok(acc.map(|[r, t]| SlabMueller {
-        r: want.reflection.then_some(r),
-        t: want.transmission.then_some(t),
-    }))
 }
 
 #[cfg(test)]

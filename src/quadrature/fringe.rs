@@ -11,7 +11,7 @@
 //! (Filon's idea, L. N. G. Filon, Proc. R. Soc. Edinb. 49, 1928: interpolate the slow factor,
 //! integrate the oscillation exactly).
 //!
-//! The channel weights are the Gaussian fits of [`crate::spectral::weights`], and the weights
+//! The channel weights are the Gaussian fits of [`crate::colour::weights`], and the weights
 //! are exact for them: for `X ~ N(μ, σ²)` and a polynomial `L`,
 //! `E[L(X) e^{iGX}] = e^{iGμ − σ²G²/2} E[L(μ + iσ²G + σZ)]` (completing the square), and the
 //! expectation is a Gauss–Hermite sum of `⌈n/2⌉` points, exact for degree `n − 1`. `W_ic` is
@@ -19,9 +19,9 @@
 //! [`STEP_NM`]: the error is below 1e-5 of the white response).
 
 use crate::band::Gaussian;
-use crate::spectral::hermite;
-use crate::spectral::nodes::{lagrange, lobatto, LEVELS};
-use crate::spectral::weights::{gaussians, WeightSet};
+use crate::colour::weights::{gaussians, WeightSet};
+use crate::quadrature::hermite;
+use crate::quadrature::nodes::{lagrange, lobatto, LEVELS};
 use num_complex::Complex64 as C64;
 use std::f64::consts::TAU;
 use std::sync::OnceLock;
@@ -210,7 +210,7 @@ pub fn rule(set: WeightSet, level: usize) -> &'static FringeRule {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::spectral::weights::fit_per_wavenumber;
+    use crate::colour::weights::fit_per_wavenumber;
 
     /// `∫ w_c(k) P(k) e^{iG(k − k₀)} dk` of the Gaussian fit by dense composite Gauss–Legendre
     /// quadrature over every Gaussian's ±9σ (written independently of the rule).
