@@ -45,7 +45,7 @@ use birefringent::plate::slab::Output;
 use birefringent::plate::slab::{Slab, SlabOptics, Want};
 use birefringent::plate::Plate;
 use birefringent::quadrature::Accuracy;
-use birefringent::spectral::model::PlateModel;
+use birefringent::spectral::model::{PlateModel, ThinModel};
 use birefringent::spectral::route::{self, Route};
 use birefringent::spectral::survey::Survey;
 use birefringent::C64;
@@ -802,12 +802,13 @@ fn analytic_timing(cases: &[Case]) -> Value {
     let mut routes: std::collections::BTreeMap<&'static str, Vec<f64>> = Default::default();
     for (c, t) in cases.iter().zip(&xyz) {
         let survey = Survey::new(&c.plate, c.frame(), c.beta()).unwrap();
-        let name = match route::choose(&survey, SET).unwrap() {
+        let name = match route::channels(&survey, SET, Accuracy::Perceptual) {
             Route::Envelope(e) if e.families.is_none() => "envelope (whole plate)",
             Route::Envelope(_) => "envelope (families of orders)",
             Route::Classes(_) => "path classes",
             Route::Dense(_) => "dense rule",
-            Route::Evanescent(_) => "evanescent (exact blocks)",
+            Route::Pointwise(_) => "pointwise (exact blocks)",
+            Route::Gaussians => "Gaussian by Gaussian",
         };
         routes.entry(name).or_default().push(*t);
     }

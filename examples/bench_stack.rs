@@ -28,7 +28,7 @@ use birefringent::params::Thickness;
 use birefringent::plate::slab::{Output, Want};
 use birefringent::plate::Plate;
 use birefringent::quadrature::Accuracy;
-use birefringent::spectral::model::PlateModel;
+use birefringent::spectral::model::{PlateModel, ThinModel};
 use birefringent::stack::exact::StackBlocks;
 use birefringent::stack::spectral::StackModel;
 use birefringent::stack::{Layer, Stack};

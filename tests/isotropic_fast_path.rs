@@ -14,8 +14,9 @@ use birefringent::plate::etalon::Etalon;
 use birefringent::plate::slab::Output;
 use birefringent::plate::slab::Want;
 use birefringent::plate::Plate;
+use birefringent::quadrature::Accuracy;
 use birefringent::spectral::gaussian::{band_with, Method};
-use birefringent::spectral::model::PlateModel;
+use birefringent::spectral::model::{PlateModel, ThinModel};
 use birefringent::C64;
 use nalgebra::{Matrix4, Vector3};
 
@@ -149,7 +150,7 @@ fn etalon_band_equals_the_general_band_integration() {
         let model = PlateModel::new(&plate, frame, beta);
         assert!(model.etalon().is_some());
         let fast = model
-            .band(&band, Want::BOTH, Output::Mueller, &mut None)
+            .band(&band, Want::BOTH, Output::Mueller, Accuracy::Perceptual)
             .unwrap();
         let method = if thick {
             Method::Paths(None)

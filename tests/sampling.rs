@@ -184,7 +184,7 @@ fn srgb_lobes_keep_negative_channels() {
     use birefringent::quadrature::Accuracy;
     use birefringent::render::plate::{plate_lobes, PlateQuery};
     use birefringent::render::thin::Spectrum;
-    use birefringent::spectral::model::PlateModel;
+    use birefringent::spectral::model::{PlateModel, ThinModel};
     let q = PlateQuery::new(
         Material::named("linbo3", 0.0, 0.0).unwrap(),
         0.0,
@@ -205,7 +205,7 @@ fn srgb_lobes_keep_negative_channels() {
     // Radiance: the core solves the plate for light arriving from the reflected direction.
     let wo = Vector3::new(0.0, theta.sin(), theta.cos());
     let direct = PlateModel::new(
-        &q.plate,
+        &q.element,
         PlaneFrame::from_direction(wo),
         C64::new(theta.sin(), 0.0),
     )

@@ -10,7 +10,7 @@ use birefringent::params::Thickness;
 use birefringent::plate::slab::{Output, Want};
 use birefringent::plate::Plate;
 use birefringent::quadrature::Accuracy;
-use birefringent::spectral::model::PlateModel;
+use birefringent::spectral::model::{PlateModel, ThinModel};
 use birefringent::C64;
 use nalgebra::{Matrix4, Vector3};
 

@@ -40,7 +40,7 @@ use birefringent::plate::slab::Output;
 use birefringent::plate::slab::{SlabMueller, Want};
 use birefringent::plate::Plate;
 use birefringent::quadrature::Accuracy;
-use birefringent::spectral::model::PlateModel;
+use birefringent::spectral::model::{PlateModel, ThinModel};
 use birefringent::C64;
 use nalgebra::Vector3;
 use std::time::Instant;

@@ -15,7 +15,7 @@ use birefringent::optics::fresnel::Fresnel;
 use birefringent::plate::slab::{Output, SlabMueller, Want};
 use birefringent::plate::Plate;
 use birefringent::quadrature::Accuracy;
-use birefringent::spectral::model::PlateModel;
+use birefringent::spectral::model::{PlateModel, ThinModel};
 use birefringent::spectral::route::{self, Route};
 use birefringent::spectral::survey::Survey;
 use birefringent::C64;
@@ -92,7 +92,11 @@ fn analytic(p: &Plate, theta_deg: f64) -> [SlabMueller; 3] {
 
 fn route_of(p: &Plate, theta_deg: f64) -> Route {
     let (frame, beta) = incidence(theta_deg);
-    route::choose(&Survey::new(p, frame, beta).unwrap(), SET).unwrap()
+    route::channels(
+        &Survey::new(p, frame, beta).unwrap(),
+        SET,
+        Accuracy::Perceptual,
+    )
 }
 
 /// The largest difference of any Mueller entry of either lobe over the channels.
@@ -152,7 +156,8 @@ fn each_route_matches_dense_quadrature_with_the_fitted_weights() {
             Route::Envelope(_) => "families",
             Route::Classes(_) => "classes",
             Route::Dense(_) => "dense",
-            Route::Evanescent(_) => "evanescent",
+            Route::Pointwise(_) => "pointwise",
+            Route::Gaussians => "gaussians",
         };
         let d = p.thickness_nm * 1e-3;
         assert_eq!(name, expected, "route of {d} um at {theta} deg: {r:?}");
@@ -229,8 +234,8 @@ fn a_weakly_absorbing_plate_turning_evanescent_takes_the_evanescent_route() {
     let (clear, weak) = (plate(0.0), plate(1e-20));
     let survey = Survey::new(&weak, frame, beta).unwrap();
     assert!(matches!(
-        route::choose(&survey, SET).unwrap(),
-        Route::Evanescent(_)
+        route::channels(&survey, SET, Accuracy::Perceptual),
+        Route::Pointwise(_)
     ));
     for (a, b) in channels(&clear).iter().zip(&channels(&weak)) {
         for (x, y) in [(a.r, b.r), (a.t, b.t)] {

@@ -26,6 +26,7 @@ use birefringent::optics::frame::PlaneFrame;
 use birefringent::params::Thickness;
 use birefringent::plate::slab::{Output, SlabMueller, Want};
 use birefringent::quadrature::Accuracy;
+use birefringent::spectral::model::ThinModel;
 use birefringent::stack::exact::StackBlocks;
 use birefringent::stack::spectral::StackModel;
 use birefringent::stack::{Layer, Stack};

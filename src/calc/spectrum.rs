@@ -14,7 +14,7 @@ use crate::params::Bandwidth;
 use crate::plate::slab::Output;
 use crate::plate::slab::{SlabMueller, Want};
 use crate::quadrature::Accuracy;
-use crate::spectral::model::PlateModel;
+use crate::spectral::model::{PlateModel, ThinModel};
 use crate::spectral::reference::quadrature;
 use nalgebra::{Matrix4, Vector4};
 use serde_json::{json, Map, Value};
@@ -218,7 +218,7 @@ fn band(q: &SlabQuery, b: f64, quad: bool, step: Option<f64>) -> Result<SlabMuel
             &[g],
             Want::BOTH,
             Output::Mueller,
-            &mut None,
+            Accuracy::Exact,
         );
     }
     let range = band_range(q.wavelength_nm, b);

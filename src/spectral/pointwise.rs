@@ -8,14 +8,13 @@
 //! turning evanescent inside the band, a critical angle: where the blocks are not smooth). The
 //! phases `k d q` are taken from the (interpolated) normal components at each point.
 
-use crate::colour::weights::{gaussians, WeightSet};
+use crate::colour::weights::WeightSet;
 use crate::error::Result;
 use crate::optics::frame::PlaneFrame;
 use crate::plate::slab::{Output, SlabBlocks, SlabMueller, Want, BLOCK_VALUES};
 use crate::plate::Plate;
-use crate::quadrature::chebyshev::{points, rule, support};
+use crate::quadrature::chebyshev::rule;
 use crate::quadrature::interpolate::Interpolant;
-use crate::spectral::group::{dispersion, group_round_trips, group_splitting};
 use nalgebra::Matrix4;
 use num_complex::Complex64 as C64;
 use std::f64::consts::TAU;
@@ -26,42 +25,6 @@ pub const TOLERANCE: f64 = 1e-10;
 /// Trailing coefficients of a plate's blocks are dropped while their sum stays below this,
 /// relative to the largest value.
 const TRUNCATION: f64 = 0.1 * TOLERANCE;
-
-/// The number of points the Chebyshev rule needs for this plate and weight set
-/// ([`crate::quadrature::chebyshev`]'s docs), or `None` if the plate's spectrum oscillates too
-/// fast for one rule (then each Gaussian is integrated on its own).
-pub fn exact_points(
-    plate: &Plate,
-    frame: &PlaneFrame,
-    beta: C64,
-    set: WeightSet,
-) -> Result<Option<usize>> {
-    let (lo, hi) = support(set);
-    // The round trip's norm, its fastest group path and the largest group path difference of
-    // the modes, at the centre and at the short end of the weights' bulk (`μ + 3σ` of the
-    // bluest Gaussian: dispersion is steepest there; beyond, that Gaussian is below 1.1 % of
-    // its peak, and the dispersion fits of some crystals, extrapolated below their data, grow
-    // without physical meaning towards the support's end; the test against a dense rule of the
-    // exact plate covers the whole support).
-    let bulk = (0..3)
-        .flat_map(|c| gaussians(set, c).iter())
-        .map(|g| g.mu + 3.0 * g.sigma)
-        .fold(0.0, f64::max)
-        .min(hi);
-    let (mut rho, mut trip, mut split) = (0.0f64, 0.0f64, 0.0f64);
-    for k in [0.5 * (lo + hi), bulk] {
-        let optics = plate.at(TAU / k)?.optics(frame, beta)?;
-        let (pd, pu) = optics.propagation(TAU / k);
-        rho = rho.max(crate::cmath::spectral_norm(
-            &(optics.top.r_below() * pu * optics.bottom.r_above() * pd),
-        ));
-        let disp = dispersion(plate, frame, beta, k)?;
-        trip = trip.max(group_round_trips(&optics, &disp, k).1);
-        split = split.max(group_splitting(&optics, &disp, k));
-    }
-    let d = plate.thickness_nm;
-    Ok(points(set, d * trip, d * split, rho))
-}
 
 /// `∫ w_c(k) M(k) dk` for the three channels of `set` on the Chebyshev rule of `points` points
 /// ([`crate::quadrature::chebyshev`]), the plate solved at every point (module docs).

@@ -1,17 +1,22 @@
-//! What a plate at one incidence looks like across the visible band, before any method is
-//! chosen: its interface blocks at the amplitude nodes ([`Amplitudes`]) and the invariants read
-//! off them (the traversals' group paths and attenuation rates, the least attenuation, the
-//! round trip's reflectance). [`crate::spectral::route`] decides from these alone; every
-//! method then starts from the same solved blocks.
+//! What a plate at one incidence looks like before any method is chosen, across the visible band
+//! ([`Survey`]: its interface blocks at the amplitude nodes, [`Amplitudes`], and the invariants
+//! read off them: the traversals' group paths and attenuation rates, the least attenuation, the
+//! round trip's reflectance) or around the centre of one Gaussian of a band ([`BandSurvey`]).
+//! [`crate::spectral::route`] decides from these alone; every method then starts from the same
+//! solved blocks, and nothing is solved again to decide.
 
+use crate::band::Gaussian;
 use crate::cmath::spectral_norm;
 use crate::error::Result;
 use crate::optics::frame::PlaneFrame;
+use crate::plate::slab::SlabOptics;
 use crate::plate::Plate;
 use crate::quadrature::budget::ATTENUATED;
 use crate::quadrature::fringe;
 use crate::quadrature::nodes::{self, SPAN};
 use crate::spectral::amplitudes::{least_attenuation, Amplitudes};
+use crate::spectral::group::{dispersion, group_round_trips, Dispersion};
+use crate::spectral::narrow::{self, Narrow};
 use num_complex::Complex64 as C64;
 use std::f64::consts::TAU;
 
@@ -105,4 +110,86 @@ fn round_trip_bound(amplitudes: &Amplitudes) -> f64 {
             spectral_norm(&b.r3) * spectral_norm(&b.r2) * most(pd) * most(pu)
         })
         .fold(0.0, f64::max)
+}
+
+/// Orders are counted until the round trip's amplitude falls below this ([`BandSurvey::orders`]).
+pub const ORDER_TOLERANCE: f64 = 1e-5;
+/// Most round trips [`BandSurvey::orders`] counts.
+pub const MAX_ORDERS: usize = 2000;
+
+/// A plate at one incidence around the centre `μ` of one unit-mass Gaussian of a band: what
+/// [`crate::spectral::route::gaussian`] decides from and the band's methods
+/// ([`crate::spectral::gaussian`]) start from.
+pub struct BandSurvey<'a> {
+    /// The plate.
+    pub plate: &'a Plate,
+    /// Its plane of incidence.
+    pub frame: PlaneFrame,
+    /// The incidence parameter.
+    pub beta: C64,
+    /// The Gaussian.
+    pub g: Gaussian,
+    /// The plate solved at the centre (for every Gaussian, without dispersion).
+    pub optics: SlabOptics,
+    /// The traversals' phase derivatives at the centre.
+    pub dispersion: Dispersion,
+    /// The smallest and largest group path per unit thickness of one round trip.
+    pub round_trips: (f64, f64),
+    /// Round trips until the amplitude falls below [`ORDER_TOLERANCE`] (at most
+    /// [`MAX_ORDERS`]).
+    pub orders: usize,
+    /// The narrow-band closed form, where it serves ([`narrow::plan`]).
+    pub narrow: Option<Narrow>,
+}
+
+impl<'a> BandSurvey<'a> {
+    /// The survey of `plate` over `g`, its interfaces at the centre `optics`.
+    pub fn new(
+        plate: &'a Plate,
+        frame: PlaneFrame,
+        beta: C64,
+        g: &Gaussian,
+        optics: SlabOptics,
+    ) -> Result<Self> {
+        let dispersion = dispersion(plate, &frame, beta, g.mu)?;
+        let traversals = traversals(&optics, &dispersion, g.mu);
+        Ok(BandSurvey {
+            plate,
+            frame,
+            beta,
+            g: *g,
+            round_trips: group_round_trips(&optics, &dispersion, g.mu),
+            orders: orders(&optics, TAU / g.mu),
+            narrow: narrow::plan(&optics, g, &traversals),
+            optics,
+            dispersion,
+        })
+    }
+}
+
+/// How each traversal's phase varies around `mu` ([`narrow::Traversal`]), from the modes at
+/// the centre and the dispersion derivatives.
+fn traversals(optics: &SlabOptics, disp: &Dispersion, mu: f64) -> [narrow::Traversal; 4] {
+    let m = optics.layer_modes();
+    let q = [-m.down[0].q, -m.down[1].q, m.up[0].q, m.up[1].q];
+    std::array::from_fn(|j| narrow::Traversal {
+        group: q[j] + mu * disp.d1[j],
+        curvature: 2.0 * disp.d1[j] + mu * disp.d2[j],
+    })
+}
+
+/// Round trips until the internal amplitude `‖r₃ P↑ r₂ P↓‖` (Frobenius, at `lambda`) falls
+/// below [`ORDER_TOLERANCE`], at most [`MAX_ORDERS`].
+fn orders(optics: &SlabOptics, lambda: f64) -> usize {
+    let (pd, pu) = optics.propagation(lambda);
+    let rho = (optics.top.r_below() * pu * optics.bottom.r_above() * pd).norm();
+    if rho <= 0.0 {
+        0
+    } else if rho >= 1.0 {
+        MAX_ORDERS
+    } else {
+        ((ORDER_TOLERANCE.ln() / rho.ln()).ceil() as usize)
+            .saturating_sub(1)
+            .min(MAX_ORDERS)
+    }
 }

@@ -30,6 +30,7 @@ use crate::quadrature::chebyshev::{self, LADDER, TOLERANCE};
 use crate::quadrature::hermite;
 use crate::quadrature::interpolate::{self, Interpolant};
 use crate::quadrature::Accuracy;
+use crate::spectral::model::ThinModel;
 use crate::stack::coherence::{self, Coherence, Prepared};
 use crate::stack::exact::{layer_q_into, StackBlocks};
 use crate::stack::plan::{layer_paths, reflectances, LayerPaths, StackPlan, Weight};
@@ -88,15 +89,6 @@ impl<'a> StackModel<'a> {
         Ok(self.fixed.get_or_init(|| b).clone())
     }
 
-    /// Exactly at `lambda_nm` (s/p frames, power fractions).
-    pub fn at(&self, lambda_nm: f64, want: Want, output: Output) -> Result<SlabMueller> {
-        let m = match self.fixed.get() {
-            Some(b) if !self.stack.is_dispersive() => b.mueller(lambda_nm, want)?,
-            _ => self.blocks(lambda_nm)?.mueller(lambda_nm, want)?,
-        };
-        Ok(output.keep(m))
-    }
-
     /// The layers' group paths at wavenumbers `ks` and the interfaces' reflectances at the
     /// first of them: what [`StackPlan`]s are made of.
     pub fn paths(&self, ks: &[f64]) -> Result<(Vec<LayerPaths>, Vec<f64>)> {
@@ -112,9 +104,9 @@ impl<'a> StackModel<'a> {
         Ok(StackPlan::new(&paths, &r, weight, exact))
     }
 
-    /// Over the Gaussian band `g` (module docs): the partially coherent model at
-    /// [`Accuracy::Perceptual`], the exact stack at [`Accuracy::Exact`].
-    pub fn band(
+    /// Over the unit-mass Gaussian `g` times its amplitude (module docs): the partially
+    /// coherent model at [`Accuracy::Perceptual`], the exact stack at [`Accuracy::Exact`].
+    fn gaussian(
         &self,
         g: &Gaussian,
         want: Want,
@@ -136,57 +128,6 @@ impl<'a> StackModel<'a> {
         let (lo, hi) = (g.mu - 6.5 * g.sigma, g.mu + 6.5 * g.sigma);
         let [m, _, _] = self.quadrature(&nodes, (lo, hi), &plan.coherence, want, output)?;
         Ok(m)
-    }
-
-    /// Over the three channels of `set`: the partially coherent model at
-    /// [`Accuracy::Perceptual`], the exact stack at [`Accuracy::Exact`] (module docs).
-    pub fn channels(
-        &self,
-        set: WeightSet,
-        want: Want,
-        output: Output,
-        accuracy: Accuracy,
-    ) -> Result<[SlabMueller; 3]> {
-        let (lo, hi) = chebyshev::support(set);
-        let bulk = (0..3)
-            .flat_map(|c| gaussians(set, c).iter())
-            .map(|g| g.mu + 3.0 * g.sigma)
-            .fold(0.0, f64::max)
-            .min(hi);
-        let exact = accuracy == Accuracy::Exact;
-        let weight = Weight::of_set(set);
-        let (paths, r) = self.paths(&[0.5 * (lo + hi), bulk])?;
-        let mut plan = StackPlan::new(&paths, &r, &weight, exact);
-        let points = |p: &StackPlan| chebyshev::points(set, p.omega_1, p.omega_b, p.rho);
-        // Too many coherent orders for any rule: the longest round trips become incoherent.
-        while points(&plan).is_none() && !exact {
-            match plan.thicken(&paths, &r, &weight) {
-                Some(p) => plan = p,
-                None => break,
-            }
-        }
-        let points = match (points(&plan), exact) {
-            (Some(p), _) => p,
-            (None, false) => LADDER[LADDER.len() - 1],
-            (None, true) => {
-                return Err(Error::new(
-                    "spectrum.method",
-                    format!(
-                        "the exact stack oscillates too fast across the visible for the exact rule \
-                         (more than {} points); use \"analytic\" or \"quadrature\"",
-                        LADDER[LADDER.len() - 1]
-                    ),
-                ))
-            }
-        };
-        let rule = chebyshev::rule(set, points);
-        self.quadrature(
-            &rule.nodes,
-            (rule.lo, rule.hi),
-            &plan.coherence,
-            want,
-            output,
-        )
     }
 
     /// `Σ_j w_cj M(k_j)` over `nodes` `(k_j, [w_cj])` inside `support`, of the model under
@@ -256,6 +197,88 @@ impl<'a> StackModel<'a> {
             r: want.reflection.then_some(r),
             t: want.transmission.then_some(t),
         }))
+    }
+}
+
+impl ThinModel for StackModel<'_> {
+    /// Exactly at `lambda_nm` (s/p frames, power fractions).
+    fn at(&self, lambda_nm: f64, want: Want, output: Output) -> Result<SlabMueller> {
+        let m = match self.fixed.get() {
+            Some(b) if !self.stack.is_dispersive() => b.mueller(lambda_nm, want)?,
+            _ => self.blocks(lambda_nm)?.mueller(lambda_nm, want)?,
+        };
+        Ok(output.keep(m))
+    }
+
+    /// Gaussian by Gaussian (module docs).
+    fn band(
+        &self,
+        band: &[Gaussian],
+        want: Want,
+        output: Output,
+        accuracy: Accuracy,
+    ) -> Result<SlabMueller> {
+        let (mut r, mut t) = (Matrix4::zeros(), Matrix4::zeros());
+        for g in band {
+            let m = self.gaussian(g, want, output, accuracy)?;
+            r += m.r.unwrap_or_default();
+            t += m.t.unwrap_or_default();
+        }
+        Ok(SlabMueller {
+            r: want.reflection.then_some(r),
+            t: want.transmission.then_some(t),
+        })
+    }
+
+    /// Over the three channels of `set`: the partially coherent model at
+    /// [`Accuracy::Perceptual`], the exact stack at [`Accuracy::Exact`] (module docs).
+    fn channels(
+        &self,
+        set: WeightSet,
+        want: Want,
+        output: Output,
+        accuracy: Accuracy,
+    ) -> Result<[SlabMueller; 3]> {
+        let (lo, hi) = chebyshev::support(set);
+        let bulk = (0..3)
+            .flat_map(|c| gaussians(set, c).iter())
+            .map(|g| g.mu + 3.0 * g.sigma)
+            .fold(0.0, f64::max)
+            .min(hi);
+        let exact = accuracy == Accuracy::Exact;
+        let weight = Weight::of_set(set);
+        let (paths, r) = self.paths(&[0.5 * (lo + hi), bulk])?;
+        let mut plan = StackPlan::new(&paths, &r, &weight, exact);
+        let points = |p: &StackPlan| chebyshev::points(set, p.omega_1, p.omega_b, p.rho);
+        // Too many coherent orders for any rule: the longest round trips become incoherent.
+        while points(&plan).is_none() && !exact {
+            match plan.thicken(&paths, &r, &weight) {
+                Some(p) => plan = p,
+                None => break,
+            }
+        }
+        let points = match (points(&plan), exact) {
+            (Some(p), _) => p,
+            (None, false) => LADDER[LADDER.len() - 1],
+            (None, true) => {
+                return Err(Error::new(
+                    "spectrum.method",
+                    format!(
+                        "the exact stack oscillates too fast across the visible for the exact rule \
+                         (more than {} points); use \"analytic\" or \"quadrature\"",
+                        LADDER[LADDER.len() - 1]
+                    ),
+                ))
+            }
+        };
+        let rule = chebyshev::rule(set, points);
+        self.quadrature(
+            &rule.nodes,
+            (rule.lo, rule.hi),
+            &plan.coherence,
+            want,
+            output,
+        )
     }
 }
 
