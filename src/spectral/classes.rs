@@ -238,8 +238,8 @@ pub fn channels(
         .iter()
         .any(|q| q.im != 0.0);
     let loss = s.loss.unwrap_or([0.0; 4]);
-    let layouts =
-        [Lobe::Reflection, Lobe::Transmission].map(|l| layout::layout(l, plan.order, absorbing));
+    let layouts = [Lobe::Reflection, Lobe::Transmission]
+        .map(|l| layout::layout(l, plan.order, absorbing, plan.cross_orders));
     // The classes at the centre decide which groups are kept.
     w.classes.expand(s.amplitudes.centre(), plan.order, want);
     for (l, layout) in layouts.iter().enumerate() {
@@ -607,13 +607,18 @@ impl Integration<'_, '_> {
             })
             .fold(0.0, f64::max);
         let tolerance = NODE_ERROR / p.strength.max(1e-300);
-        let points = chebyshev::LADDER
-            .iter()
+        // The bound falls with the points: the rungs that serve are a suffix of the ladder
+        // (bisected, and confirmed).
+        let ladder = &chebyshev::LADDER;
+        let serves = |n: &usize| {
+            chebyshev::error_bound(self.set, *n, chebyshev::SPAN_MARGIN * fastest) <= tolerance
+        };
+        let points = ladder
+            .get(ladder.partition_point(|n| !serves(n)))
             .copied()
-            .find(|&n| {
-                chebyshev::rule(self.set, n).error_at(chebyshev::SPAN_MARGIN * fastest) <= tolerance
-            })
-            .unwrap_or(chebyshev::LADDER[chebyshev::LADDER.len() - 1]);
+            .filter(serves)
+            .or_else(|| ladder.iter().copied().find(serves))
+            .unwrap_or(ladder[ladder.len() - 1]);
         let rule = chebyshev::rule(self.set, points);
         let i = match chirped.iter().position(|t| t.points == rule.nodes.len()) {
             Some(i) => i,
@@ -633,12 +638,12 @@ impl Integration<'_, '_> {
         let table = &chirped[i];
         let bases = chebyshev::node_basis(self.set, points, p.amplitude_level);
         let n = LEVELS[p.amplitude_level];
-        let rows = rule.nodes.iter().zip(bases);
+        let rows = rule.nodes.iter().zip(bases.chunks_exact(n));
         for (((_, w), basis), (phi, alpha)) in rows.zip(table.phase.iter().zip(&table.attenuation))
         {
             let factor = C64::from_polar((-dot(&sum, alpha)).exp(), dot(&delta, phi));
             let fw = [factor * w[0], factor * w[1], factor * w[2]];
-            for (o, l) in out.iter_mut().zip(&basis[..n]) {
+            for (o, l) in out.iter_mut().zip(basis) {
                 for c in 0..3 {
                     o[c] += fw[c] * *l;
                 }

@@ -37,12 +37,12 @@ pub fn channels(
     let basis = chebyshev::node_basis(set, points, level);
     let mut acc = [[Matrix4::<f64>::zeros(); 2]; 3];
     let mut v = [C64::new(0.0, 0.0); BLOCK_VALUES];
-    for (&(k, w), b) in rule.nodes.iter().zip(basis) {
+    for (&(k, w), b) in rule.nodes.iter().zip(basis.chunks_exact(n)) {
         let blocks = if n == 1 {
             *s.amplitudes.centre()
         } else {
             v.iter_mut().for_each(|x| *x = C64::new(0.0, 0.0));
-            for (node, &bi) in values[..n].iter().zip(&b[..n]) {
+            for (node, &bi) in values[..n].iter().zip(b) {
                 for (x, y) in v.iter_mut().zip(node) {
                     *x += y * bi;
                 }

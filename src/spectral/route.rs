@@ -23,7 +23,6 @@ use crate::quadrature::Accuracy;
 use crate::spectral::classes;
 use crate::spectral::envelope;
 use crate::spectral::gaussian::{coherent_order, Method, MAX_ORDER, PAIR_CUTOFF};
-use crate::spectral::layout;
 use crate::spectral::survey::{BandSurvey, Survey};
 use num_complex::Complex64 as C64;
 
@@ -272,16 +271,20 @@ fn envelope_cost(s: &Survey, p: &envelope::Envelope) -> f64 {
 
 fn classes_cost(s: &Survey, p: &classes::Orders) -> f64 {
     let orders = (p.order + 1) as f64;
+    // The pairs of classes a query may visit (of the same order only, where different orders
+    // are invisible), counted from the classes per order (no layout is built to decide).
     let pairs: usize = [Lobe::Reflection, Lobe::Transmission]
         .iter()
         .map(|&l| {
-            let layout = layout::layout(l, p.order, false);
-            layout
-                .blocks
-                .iter()
-                .filter(|b| p.cross_orders || b.orders.0 == b.orders.1)
-                .map(|b| b.pairs.end - b.pairs.start)
-                .sum::<usize>()
+            let per_order = |o: usize| l.classes(o) - if o == 0 { 0 } else { l.classes(o - 1) };
+            let all = l.classes(p.order);
+            if p.cross_orders {
+                all * (all + 1) / 2
+            } else {
+                (0..=p.order)
+                    .map(|o| per_order(o) * (per_order(o) + 1) / 2)
+                    .sum()
+            }
         })
         .sum();
     LEVELS[s.amplitudes.level] as f64
