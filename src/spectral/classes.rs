@@ -607,18 +607,10 @@ impl Integration<'_, '_> {
             })
             .fold(0.0, f64::max);
         let tolerance = NODE_ERROR / p.strength.max(1e-300);
-        // The bound falls with the points: the rungs that serve are a suffix of the ladder
-        // (bisected, and confirmed).
-        let ladder = &chebyshev::LADDER;
-        let serves = |n: &usize| {
-            chebyshev::error_bound(self.set, *n, chebyshev::SPAN_MARGIN * fastest) <= tolerance
-        };
-        let points = ladder
-            .get(ladder.partition_point(|n| !serves(n)))
-            .copied()
-            .filter(serves)
-            .or_else(|| ladder.iter().copied().find(serves))
-            .unwrap_or(ladder[ladder.len() - 1]);
+        let points = chebyshev::smallest_rung(self.set, |error| {
+            error(chebyshev::SPAN_MARGIN * fastest) <= tolerance
+        })
+        .unwrap_or(chebyshev::LADDER[chebyshev::LADDER.len() - 1]);
         let rule = chebyshev::rule(self.set, points);
         let i = match chirped.iter().position(|t| t.points == rule.nodes.len()) {
             Some(i) => i,

@@ -12,6 +12,7 @@
 
 use crate::band::Gaussian;
 use crate::colour::weights::{gaussians, WeightSet};
+use crate::error::{Error, Result};
 use crate::plate::etalon::Etalon;
 use crate::plate::paths::Lobe;
 use crate::plate::Plate;
@@ -134,6 +135,34 @@ pub fn rule_points(s: &Survey, set: WeightSet) -> Option<usize> {
         }
     }
     chebyshev::points(set, rates.0, rates.1, s.rho)
+}
+
+/// The route of a thin element that only a Chebyshev rule of its exact model serves (a stack of
+/// layers, [`crate::stack::survey`]), from its survey and the points the rule needs for its
+/// frequencies ([`chebyshev::points`], `None` beyond [`LADDER`]): its blocks interpolated from
+/// the survey's nodes ([`Route::Dense`]) where they are `interpolable` (no wave turning
+/// evanescent inside the band, the nodes converged), else solved at every point
+/// ([`Route::Pointwise`]); at most [`LADDER`]'s largest rung, which [`Accuracy::Exact`] refuses.
+pub fn rule(interpolable: bool, points: Option<usize>, accuracy: Accuracy) -> Result<Route> {
+    let most = LADDER[LADDER.len() - 1];
+    let points = match (points, accuracy) {
+        (Some(p), _) => p,
+        (None, Accuracy::Perceptual) => most,
+        (None, Accuracy::Exact) => {
+            return Err(Error::new(
+                "spectrum.method",
+                format!(
+                    "the exact stack oscillates too fast across the visible for the exact rule \
+                     (more than {most} points); use \"analytic\" or \"quadrature\""
+                ),
+            ))
+        }
+    };
+    Ok(if interpolable {
+        Route::Dense(points)
+    } else {
+        Route::Pointwise(points)
+    })
 }
 
 /// True if the etalon's closed form serves the Gaussian `g` (its series is not too long:

@@ -17,6 +17,7 @@ pub mod coherence;
 pub mod exact;
 pub mod plan;
 pub mod spectral;
+pub mod survey;
 
 use crate::error::{Error, Result};
 use crate::material::{check_clear_index, Material};

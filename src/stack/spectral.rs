@@ -22,18 +22,20 @@
 //! stacks): mean CIEDE2000 ≤ 0.1, worst ≤ 0.5, as for one plate.
 
 use crate::band::Gaussian;
-use crate::colour::weights::{gaussians, WeightSet};
+use crate::colour::weights::WeightSet;
 use crate::error::{Error, Result};
 use crate::optics::frame::PlaneFrame;
 use crate::plate::slab::{Output, SlabMueller, Want};
-use crate::quadrature::chebyshev::{self, LADDER, TOLERANCE};
+use crate::quadrature::chebyshev::{self, TOLERANCE};
 use crate::quadrature::hermite;
 use crate::quadrature::interpolate::{self, Interpolant};
 use crate::quadrature::Accuracy;
 use crate::spectral::model::ThinModel;
+use crate::spectral::route::{self, Route};
 use crate::stack::coherence::{self, Coherence, Prepared};
 use crate::stack::exact::{layer_q_into, StackBlocks};
 use crate::stack::plan::{layer_paths, reflectances, LayerPaths, StackPlan, Weight};
+use crate::stack::survey::StackSurvey;
 use crate::stack::Stack;
 use nalgebra::Matrix4;
 use num_complex::Complex64 as C64;
@@ -239,46 +241,78 @@ impl ThinModel for StackModel<'_> {
         output: Output,
         accuracy: Accuracy,
     ) -> Result<[SlabMueller; 3]> {
-        let (lo, hi) = chebyshev::support(set);
-        let bulk = (0..3)
-            .flat_map(|c| gaussians(set, c).iter())
-            .map(|g| g.mu + 3.0 * g.sigma)
-            .fold(0.0, f64::max)
-            .min(hi);
         let exact = accuracy == Accuracy::Exact;
+        let survey = StackSurvey::new(self.stack, self.frame, self.beta)?;
         let weight = Weight::of_set(set);
-        let (paths, r) = self.paths(&[0.5 * (lo + hi), bulk])?;
-        let mut plan = StackPlan::new(&paths, &r, &weight, exact);
+        let paths = survey.layer_paths(set);
+        let r = &survey.reflectance;
+        let mut plan = StackPlan::new(&paths, r, &weight, exact);
         let points = |p: &StackPlan| chebyshev::points(set, p.omega_1, p.omega_b, p.rho);
         // Too many coherent orders for any rule: the longest round trips become incoherent.
         while points(&plan).is_none() && !exact {
-            match plan.thicken(&paths, &r, &weight) {
+            match plan.thicken(&paths, r, &weight) {
                 Some(p) => plan = p,
                 None => break,
             }
         }
-        let points = match (points(&plan), exact) {
-            (Some(p), _) => p,
-            (None, false) => LADDER[LADDER.len() - 1],
-            (None, true) => {
-                return Err(Error::new(
-                    "spectrum.method",
-                    format!(
-                        "the exact stack oscillates too fast across the visible for the exact rule \
-                         (more than {} points); use \"analytic\" or \"quadrature\"",
-                        LADDER[LADDER.len() - 1]
-                    ),
-                ))
-            }
-        };
+        let (points, interpolated) =
+            match route::rule(survey.interpolable, points(&plan), accuracy)? {
+                Route::Dense(p) => (p, true),
+                Route::Pointwise(p) => (p, false),
+                other => unreachable!("a stack's rule route: {other:?}"),
+            };
         let rule = chebyshev::rule(set, points);
-        self.quadrature(
-            &rule.nodes,
-            (rule.lo, rule.hi),
-            &plan.coherence,
-            want,
-            output,
-        )
+        let prepared = Prepared::structure(&plan.coherence);
+        let mut acc = [[Matrix4::zeros(); 2]; 3];
+        let n = survey.nodes.len();
+        let values: Vec<Vec<C64>> = survey.nodes.iter().map(|b| b.values()).collect();
+        let basis = chebyshev::node_basis(set, points, survey.level);
+        let mut blocks = survey.nodes[n / 2].clone();
+        let mut v = blocks.values();
+        let fixed = if n == 1 {
+            Prepared::new(&blocks, &plan.coherence)
+        } else {
+            Prepared::structure(&plan.coherence)
+        };
+        for (j, (k, w)) in rule.nodes.iter().enumerate() {
+            let m = if n == 1 {
+                // Without dispersion the blocks, and the layers' q, are the same everywhere.
+                coherence::mueller(&blocks, &plan.coherence, &fixed, TAU / k, want)?
+            } else {
+                if interpolated {
+                    v.iter_mut().for_each(|x| *x = C64::new(0.0, 0.0));
+                    for (node, &bi) in values.iter().zip(&basis[j * n..(j + 1) * n]) {
+                        for (x, y) in v.iter_mut().zip(node) {
+                            *x += y * bi;
+                        }
+                    }
+                    blocks.set_values(&v);
+                    layer_q_into(self.stack, TAU / k, &self.frame, self.beta, &mut blocks.q)?;
+                } else {
+                    blocks = self.solve(*k)?;
+                }
+                coherence::mueller(&blocks, &plan.coherence, &prepared, TAU / k, want)?
+            };
+            add_weighted(&mut acc, &m, w, output);
+        }
+        Ok(acc.map(|[r, t]| SlabMueller {
+            r: want.reflection.then_some(r),
+            t: want.transmission.then_some(t),
+        }))
+    }
+}
+
+/// `acc[c][lobe] += w_c M_lobe` over the entries the output needs.
+fn add_weighted(acc: &mut [[Matrix4<f64>; 2]; 3], m: &SlabMueller, w: &[f64; 3], output: Output) {
+    let lobes = [m.r, m.t];
+    for (sums, wc) in acc.iter_mut().zip(w) {
+        for (sum, lobe) in sums.iter_mut().zip(&lobes) {
+            match (lobe, output) {
+                (Some(x), Output::Mueller) => *sum += x * *wc,
+                (Some(x), Output::Intensity) => sum[(0, 0)] += x[(0, 0)] * wc,
+                (None, _) => {}
+            }
+        }
     }
 }
 
