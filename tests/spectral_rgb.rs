@@ -272,6 +272,46 @@ pub fn extended_cases(n: usize, seed: u64) -> Vec<Case> {
     (0..n).map(|i| random_extended_case(&mut rng, i)).collect()
 }
 
+/// The `index`-th plate of the near-grazing hard set (issue 30): half of them rutile, sapphire,
+/// lithium niobate or calcite of 3-17 µm at 79-86°, half a named crystal 50-500 µm thick at
+/// 88.5-89.5°; random optic axis and azimuth, air on both sides.
+pub fn random_hard_case(rng: &mut Rng, index: usize) -> Case {
+    let (name, thickness_nm, theta_deg) = if index.is_multiple_of(2) {
+        let names = ["rutile", "sapphire", "linbo3", "calcite"];
+        (
+            names[rng.index(names.len())],
+            rng.range(3e3, 17e3),
+            rng.range(79.0, 86.0),
+        )
+    } else {
+        (
+            CRYSTALS[rng.index(CRYSTALS.len())],
+            rng.range(50e3, 500e3),
+            rng.range(88.5, 89.5),
+        )
+    };
+    Case {
+        index,
+        kind: Kind::Crystal(name),
+        plate: Plate {
+            material: Material::named(name, 0.0, 0.0).unwrap(),
+            birefringence: 0.0,
+            ext: C64::new(1.0, 0.0),
+            exit: C64::new(1.0, 0.0),
+            axis: rng.unit_vector(),
+            thickness_nm,
+        },
+        theta_deg,
+        phi_deg: rng.range(0.0, 360.0),
+    }
+}
+
+/// The first `n` cases of the near-grazing hard set of seed `seed`.
+pub fn hard_cases(n: usize, seed: u64) -> Vec<Case> {
+    let mut rng = Rng::new(seed);
+    (0..n).map(|i| random_hard_case(&mut rng, i)).collect()
+}
+
 /// `[crossed, parallel, reflection]` of one pair of Mueller matrices (see the module docs).
 pub fn quantities(m: &SlabMueller) -> [f64; 3] {
     let t = m.t.expect("transmission");
@@ -336,6 +376,17 @@ pub fn quadrature_step(case: &Case) -> f64 {
         l += 2.0;
     }
     (s / (16.0 * plate.thickness_nm)).min(0.5) * (1.0 - round_trip_reflectance(case)).max(1e-3)
+}
+
+/// The quadrature step of the near-grazing hard set: [`quadrature_step`], and at most a tenth
+/// of the internal-reflection fringes' spacing `λ² cos θ / (2 n_g d)` at 360 nm (θ the
+/// incidence, `n_g` the largest group index there; issue 30), at least 1e-5 nm.
+pub fn hard_quadrature_step(case: &Case) -> f64 {
+    let plate = &case.plate;
+    let grazing = RANGE.0 * RANGE.0 * case.theta_deg.to_radians().cos()
+        / (2.0 * group_index(&plate.material, RANGE.0).max(1.0) * plate.thickness_nm)
+        / 10.0;
+    quadrature_step(case).min(grazing).max(1e-5)
 }
 
 /// The largest `‖r₃‖ ‖r₂‖` (spectral norms of the internal reflections at the top and bottom
@@ -464,10 +515,15 @@ pub struct Outcome {
 
 /// Runs one case.
 pub fn compare(case: &Case, with_fitted: bool) -> Outcome {
+    compare_with_step(case, quadrature_step(case), with_fitted)
+}
+
+/// [`compare`] with the reference's step `step_nm`.
+pub fn compare_with_step(case: &Case, step_nm: f64, with_fitted: bool) -> Outcome {
     let t0 = Instant::now();
     let analytic = analytic(case);
     let t1 = Instant::now();
-    let reference = reference(case, quadrature_step(case), with_fitted);
+    let reference = reference(case, step_nm, with_fitted);
     let t2 = Instant::now();
     let de = std::array::from_fn(|q| delta_e(analytic[q], reference.tabulated[q]));
     let de_fitted = reference

@@ -245,3 +245,55 @@ fn a_weakly_absorbing_plate_turning_evanescent_takes_the_evanescent_route() {
         }
     }
 }
+
+/// The survey's round-trip decay bounds every power of the round trip `D = r₃ P↑ r₂ P↓` at its
+/// amplitude nodes, `‖Dⁿ‖ ≤ C ρⁿ` (here to `n = 40`, beyond the 8 powers the survey takes), on a
+/// plate near grazing incidence whose single round trip's norm exceeds 1 while the round trips
+/// decay (calcite 90.4 µm at 89.489°): there `ρ < 1` and `C > 1` (without the transient `C`,
+/// `ρⁿ` alone would not bound the first powers; with `ρ` from `‖D‖`, the orders would not
+/// converge).
+#[test]
+fn round_trip_decay_bounds_every_power() {
+    use birefringent::quadrature::{fringe, nodes};
+    let p = Plate {
+        axis: Vector3::new(0.3, -0.5, 0.8).normalize(),
+        ..plate(Material::named("calcite", 0.0, 0.0).unwrap(), 90.4e3, 1.0)
+    };
+    let frame = PlaneFrame::from_azimuth(182.26f64.to_radians());
+    let beta = C64::new(89.489f64.to_radians().sin(), 0.0);
+    let s = Survey::new(&p, frame, beta).unwrap();
+    assert!(s.rho < 1.0, "ρ = {}", s.rho);
+    // The largest singular value of a 2x2 matrix.
+    let norm = |m: &nalgebra::Matrix2<C64>| {
+        let h = m.adjoint() * m;
+        let (tr, det) = (h.trace().re, h.determinant().re);
+        (0.5 * (tr + (tr * tr - 4.0 * det).max(0.0).sqrt())).sqrt()
+    };
+    let (k0, a) = fringe::band();
+    let lv = nodes::level(s.amplitudes.level);
+    let mut first = 0.0f64;
+    for (&j, t) in lv.in_finest.iter().zip(&lv.nodes) {
+        let b = s.amplitudes.exact(j).unwrap();
+        let (pd, pu) = b.propagation(TAU / (k0 + a * t));
+        let diag = |p: [C64; 2]| {
+            nalgebra::Matrix2::new(p[0], C64::new(0.0, 0.0), C64::new(0.0, 0.0), p[1])
+        };
+        let d = b.r3 * diag(pu) * b.r2 * diag(pd);
+        first = first.max(norm(&d));
+        let mut dn = d;
+        for n in 1..=40 {
+            let bound = s.transient * s.rho.powi(n);
+            assert!(
+                norm(&dn) <= bound * (1.0 + 1e-9),
+                "‖D^{n}‖ = {} > C ρ^n = {bound}",
+                norm(&dn)
+            );
+            dn *= d;
+        }
+    }
+    assert!(
+        first > 1.0 && s.transient > 1.0,
+        "‖D‖ = {first}, C = {}",
+        s.transient
+    );
+}

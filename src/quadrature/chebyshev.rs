@@ -506,8 +506,16 @@ fn normal_pdf(k: f64, g: &Gaussian) -> f64 {
 }
 
 /// The smallest rung of [`LADDER`] whose rule integrates oscillations of amplitude 1 up to
-/// `omega_b` and of amplitude `a_n` up to `n omega_1 + omega_b` to [`TOLERANCE`] (module docs).
-pub fn points(set: WeightSet, omega_1: f64, omega_b: f64, rho: f64) -> Option<usize> {
+/// `omega_b` and of amplitude `a_n` up to `n omega_1 + omega_b` to [`TOLERANCE`] (module docs;
+/// `a_n = C² ρⁿ/(1 − ρ)²` with the transient `C` of a round trip's first powers, 1 where `ρ`
+/// bounds every power).
+pub fn points(
+    set: WeightSet,
+    omega_1: f64,
+    omega_b: f64,
+    rho: f64,
+    transient: f64,
+) -> Option<usize> {
     if !(omega_1.is_finite() && omega_b.is_finite() && (0.0..1.0).contains(&rho)) {
         return None;
     }
@@ -516,7 +524,7 @@ pub fn points(set: WeightSet, omega_1: f64, omega_b: f64, rho: f64) -> Option<us
         if !fits(1.0, omega_b) {
             return false;
         }
-        let mut a = 1.0 / ((1.0 - rho) * (1.0 - rho));
+        let mut a = transient * transient / ((1.0 - rho) * (1.0 - rho));
         for n in 1.. {
             a *= rho;
             if a <= TOLERANCE {
@@ -636,11 +644,11 @@ mod tests {
     #[test]
     fn points_grow_with_frequency_and_round_trip() {
         let set = WeightSet::SrgbD65;
-        let thin = points(set, 20.0 / 0.011, 0.0, 0.1).unwrap();
-        assert!(points(set, 40.0 / 0.011, 0.0, 0.1).unwrap() >= thin);
-        assert!(points(set, 20.0 / 0.011, 0.0, 0.5).unwrap() >= thin);
-        assert_eq!(points(set, 1e9, 0.0, 0.1), None);
-        assert_eq!(points(set, f64::NAN, 0.0, 0.1), None);
-        assert_eq!(points(set, 1.0, 0.0, 1.0), None);
+        let thin = points(set, 20.0 / 0.011, 0.0, 0.1, 1.0).unwrap();
+        assert!(points(set, 40.0 / 0.011, 0.0, 0.1, 1.0).unwrap() >= thin);
+        assert!(points(set, 20.0 / 0.011, 0.0, 0.5, 1.0).unwrap() >= thin);
+        assert_eq!(points(set, 1e9, 0.0, 0.1, 1.0), None);
+        assert_eq!(points(set, f64::NAN, 0.0, 0.1, 1.0), None);
+        assert_eq!(points(set, 1.0, 0.0, 1.0, 1.0), None);
     }
 }

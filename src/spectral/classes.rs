@@ -80,7 +80,8 @@ pub fn plan(s: &Survey, set: WeightSet) -> Option<Orders> {
             g[0].min(g[1]) + g[2].min(g[3]) - 2.0 * split
         })
         .0;
-    let sum = 1.0 / (1.0 - rho);
+    // The n-th round trip weighs at most C ρⁿ (the survey's transient).
+    let sum = s.transient / (1.0 - rho);
     let order = (0..=MAX_ORDER)
         .find(|&n| {
             let next = (n + 1) as f64;
@@ -93,7 +94,8 @@ pub fn plan(s: &Survey, set: WeightSet) -> Option<Orders> {
     Some(Orders {
         order,
         cross_orders,
-        tail_strength: rho.powi(2 * (order as i32 + 1)) / (1.0 - rho * rho),
+        tail_strength: s.transient * s.transient * rho.powi(2 * (order as i32 + 1))
+            / (1.0 - rho * rho),
     })
 }
 

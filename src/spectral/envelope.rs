@@ -82,6 +82,8 @@ struct Rates {
     split: [f64; 2],
     tilt: f64,
     rho: f64,
+    /// The survey's transient `C` (the `n`-th round trip at most `C ρⁿ`).
+    transient: f64,
 }
 
 impl Rates {
@@ -107,6 +109,7 @@ impl Rates {
                 split: [0.0; 2],
                 tilt: 0.0,
                 rho: 0.0,
+                transient: 1.0,
             });
         };
         let (lo, hi) = s.group_path_range(|g| g[bd] + g[bu]);
@@ -124,6 +127,7 @@ impl Rates {
             split,
             tilt: s.attenuation_tilt(),
             rho: s.rho,
+            transient: s.transient,
         })
     }
 
@@ -144,7 +148,10 @@ impl Rates {
                 per_nm: a * e.im,
                 rho: self.rho,
             };
-            let Some(m) = bound(&growth) else { break };
+            // Each side of a pair of orders carries at most the transient C.
+            let Some(m) = bound(&growth).map(|m| m * self.transient * self.transient) else {
+                break;
+            };
             for (l, b) in best.iter_mut().enumerate().skip(first) {
                 *b = b.min(4.0 * m * e.inverse_powers[l] / (e.r - 1.0));
             }
@@ -285,7 +292,7 @@ fn last_family(r: &Rates, set: WeightSet) -> Option<usize> {
     if g <= 0.0 {
         return None;
     }
-    let geometric = 1.0 / (1.0 - r.rho * r.rho);
+    let geometric = r.transient * r.transient / (1.0 - r.rho * r.rho);
     let remainder = 1e-2 * DROP * (1.0 - r.rho) / geometric;
     let strong = if r.rho > 0.0 && remainder < 1.0 {
         (remainder.ln() / (2.0 * r.rho.ln())).ceil()

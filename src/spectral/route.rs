@@ -134,7 +134,7 @@ pub fn rule_points(s: &Survey, set: WeightSet) -> Option<usize> {
             break;
         }
     }
-    chebyshev::points(set, rates.0, rates.1, s.rho)
+    chebyshev::points(set, rates.0, rates.1, s.rho, s.transient)
 }
 
 /// The route of a thin element that only a Chebyshev rule of its exact model serves (a stack of

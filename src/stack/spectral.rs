@@ -247,7 +247,7 @@ impl ThinModel for StackModel<'_> {
         let paths = survey.layer_paths(set);
         let r = &survey.reflectance;
         let mut plan = StackPlan::new(&paths, r, &weight, exact);
-        let points = |p: &StackPlan| chebyshev::points(set, p.omega_1, p.omega_b, p.rho);
+        let points = |p: &StackPlan| chebyshev::points(set, p.omega_1, p.omega_b, p.rho, 1.0);
         // Too many coherent orders for any rule: the longest round trips become incoherent.
         while points(&plan).is_none() && !exact {
             match plan.thicken(&paths, r, &weight) {
