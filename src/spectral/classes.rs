@@ -128,6 +128,12 @@ struct Work {
     series: Option<TraversalSeries>,
     /// The traversals' phases on the shared rules the chirped groups use (one per rung).
     chirped: Vec<TraversalPhases>,
+    /// Per class `a` of a lobe summed by [`Sums::Classes`]: `B_ac` per channel at the current
+    /// node, and the node it was last cleared at (`u32::MAX`: never).
+    class_sums: Vec<([Matrix2<C64>; 3], u32)>,
+    /// The slots of [`Work::class_sums`] with a `B_ac` at the current node (reflected
+    /// classes first, then transmitted ones).
+    touched: Vec<u32>,
 }
 
 /// Nodes of [`PHASE_LEVEL`].
@@ -215,6 +221,8 @@ fn work() -> Pooled<Work> {
             q: [None; MAX_NODES],
             series: None,
             chirped: Vec::new(),
+            class_sums: Vec::new(),
+            touched: Vec::new(),
         })
     });
     w.placed.clear();
@@ -225,6 +233,24 @@ fn work() -> Pooled<Work> {
     w
 }
 
+/// How the pairs of a lobe's groups are summed into its coherency at an amplitude node
+/// `i`, `K_ic = Σ_g ω_gic Σ_(a,b)∈g w_ab cross(A_a, A_b)` (`w` = 1 for a class with itself, 2
+/// otherwise); both orders of summation give the same value to rounding.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Sums {
+    /// Per group its pair sum `S_g = Σ w cross(A_a, A_b)` (16 complex products a pair), then
+    /// `ω_gic S_g` per channel (48 a group).
+    Pairs,
+    /// Pair-free: per class `a`, `B_ac = Σ_(a,b) w ω_gic A_b` over its pairs (12 a pair), then
+    /// one `cross(A_a, B_ac)` per channel (48 a class).
+    Classes,
+    /// Per lobe, the one of the two with fewer products for its kept groups (`16 P + 48 G`
+    /// against `12 P + 48 C` for `P` pairs in `G` groups of `C` first classes): the classes'
+    /// sums where a lobe's pairs spread over many groups (thin plates, many visible fringes),
+    /// the groups' where a few groups hold many pairs (thick plates: the diagonal groups).
+    Cheaper,
+}
+
 /// `∫ w_c M` for the channels of `set` by `plan` (module docs).
 pub fn channels(
     s: &Survey,
@@ -232,6 +258,18 @@ pub fn channels(
     set: WeightSet,
     want: Want,
     output: Output,
+) -> Result<[SlabMueller; 3]> {
+    channels_summed(s, plan, set, want, output, Sums::Cheaper)
+}
+
+/// [`channels`] with the pairs summed by `sums`.
+pub fn channels_summed(
+    s: &Survey,
+    plan: &Orders,
+    set: WeightSet,
+    want: Want,
+    output: Output,
+    sums: Sums,
 ) -> Result<[SlabMueller; 3]> {
     let mut w = work();
     let w = &mut *w;
@@ -260,6 +298,17 @@ pub fn channels(
         }
     }
     phases(s, w)?;
+    let by_classes = [0, 1].map(|l| match sums {
+        Sums::Pairs => false,
+        Sums::Classes => true,
+        Sums::Cheaper => classes_cheaper(layouts[l], w.placed.iter().filter(|p| p.lobe == l)),
+    });
+    // Every slot cleared at its first use in a node (`u32::MAX`: at none yet).
+    w.class_sums.clear();
+    w.class_sums.resize(
+        layouts[0].counts.len() + layouts[1].counts.len(),
+        ([Matrix2::zeros(); 3], u32::MAX),
+    );
     let it = Integration { s, set };
     for p in 0..w.placed.len() {
         let start = w.omega.len();
@@ -310,10 +359,43 @@ pub fn channels(
                 continue;
             };
             let layout = layouts[p.lobe];
-            let m = pair_sum(layout, &layout.groups[p.group], &w.classes, p.lobe, output);
             let shares = &w.omega[p.omega + node];
+            let group = &layout.groups[p.group];
+            if by_classes[p.lobe] {
+                let amps = lobe_amplitudes(&w.classes, p.lobe);
+                let offset = p.lobe * layouts[0].counts.len();
+                for &(a, b) in &layout.pairs[group.pairs.clone()] {
+                    let slot = offset + a as usize;
+                    let (sum, stamp) = &mut w.class_sums[slot];
+                    if *stamp != i as u32 {
+                        *stamp = i as u32;
+                        *sum = [Matrix2::zeros(); 3];
+                        w.touched.push(slot as u32);
+                    }
+                    let weight = if a == b { 1.0 } else { 2.0 };
+                    for (b_c, share) in sum.iter_mut().zip(shares) {
+                        *b_c += amps[b as usize] * (share * weight);
+                    }
+                }
+                continue;
+            }
+            let m = pair_sum(layout, group, &w.classes, p.lobe, output);
             for (acc_c, share) in acc.iter_mut().zip(shares) {
                 add_scaled(&mut acc_c[p.lobe], &m, *share, output);
+            }
+        }
+        // The classes' sums of both lobes (a lobe's classes in its own range of `class_sums`).
+        let reflected = layouts[0].counts.len();
+        for slot in w.touched.drain(..) {
+            let slot = slot as usize;
+            let (l, a) = if slot < reflected {
+                (0, slot)
+            } else {
+                (1, slot - reflected)
+            };
+            let x = &lobe_amplitudes(&w.classes, l)[a];
+            for (acc_c, b_c) in acc.iter_mut().zip(&w.class_sums[slot].0) {
+                cross_add(&mut acc_c[l], x, b_c, 1.0, output == Output::Intensity);
             }
         }
         if let Some(node) = index[tail_level] {
@@ -646,6 +728,36 @@ impl Integration<'_, '_> {
     }
 }
 
+/// The amplitudes of lobe `l`'s classes (0: reflection, 1: transmission).
+fn lobe_amplitudes(classes: &ClassAmplitudes, l: usize) -> &[Matrix2<C64>] {
+    if l == 0 {
+        &classes.reflection
+    } else {
+        &classes.transmission
+    }
+}
+
+/// True if [`Sums::Classes`] takes fewer complex products than [`Sums::Pairs`] for a lobe's
+/// kept groups `placed` (the costs of [`Sums`]).
+fn classes_cheaper<'a>(layout: &Layout, placed: impl Iterator<Item = &'a Placed>) -> bool {
+    let (mut pairs, mut groups) = (0usize, 0usize);
+    // A lobe has at most 385 classes (reflection at `MAX_ORDER`); a class beyond would only
+    // be miscounted, never summed wrongly.
+    let mut first = [false; 512];
+    let mut classes = 0usize;
+    for p in placed {
+        let range = layout.groups[p.group].pairs.clone();
+        pairs += range.len();
+        groups += 1;
+        for &(a, _) in &layout.pairs[range] {
+            let seen = &mut first[(a as usize).min(first.len() - 1)];
+            classes += usize::from(!*seen);
+            *seen = true;
+        }
+    }
+    12 * pairs + 48 * classes < 16 * pairs + 48 * groups
+}
+
 /// `Σ_pairs w cross(A_a, A_b)` of a group at one node (`w` = 1 for a class with itself, 2
 /// otherwise), all 16 entries or only those of `M00`.
 fn pair_sum(
@@ -655,11 +767,7 @@ fn pair_sum(
     lobe: usize,
     output: Output,
 ) -> Matrix4<C64> {
-    let amps: &[Matrix2<C64>] = if lobe == 0 {
-        &classes.reflection
-    } else {
-        &classes.transmission
-    };
+    let amps = lobe_amplitudes(classes, lobe);
     let mut m = Matrix4::zeros();
     for &(a, b) in &layout.pairs[g.pairs.clone()] {
         let w = if a == b { 1.0 } else { 2.0 };
