@@ -20,11 +20,12 @@ use birefringent::optics::surface::Surface;
 use birefringent::params::Thickness;
 use birefringent::render::choice::{choose, Choice};
 use birefringent::render::crystal::crystal_slots;
-use birefringent::render::plate::{plate_lobes, PlateQuery, Spectrum};
+use birefringent::render::plate::{plate_lobes, PlateQuery};
 use birefringent::render::slots::Slots;
 use birefringent::render::tangents::{
     Columns, Input, Lane, Point, Stencil, RELATIVE_STEP, STENCIL,
 };
+use birefringent::render::thin::Spectrum;
 use birefringent::render::Transport;
 use birefringent::{Result, C64};
 use nalgebra::Vector3;

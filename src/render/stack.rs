@@ -1,57 +1,23 @@
 //! The lobes of a stack of layers (reflection and transmission) as a path tracer samples them,
 //! over one wavelength, a band or a set of colour channels: [`crate::render::thin`] with the
-//! stack's models of [`crate::stack::spectral`].
+//! stack's model of [`crate::stack::spectral`].
 
-use crate::band::{is_exact_band, narrow_band};
 use crate::error::Result;
 use crate::optics::frame::PlaneFrame;
-use crate::plate::slab::{Output, SlabMueller, Want};
-use crate::render::plate::Spectrum;
-use crate::render::thin::{self, Thin};
+use crate::render::thin::{self, Spectrum, Thin, ThinQuery};
 use crate::render::{PathLobe, Transport};
-use crate::spectral::model::Accuracy;
 use crate::stack::spectral::StackModel;
 use crate::stack::Stack;
 use nalgebra::Vector3;
 use num_complex::Complex64 as C64;
 
 /// A stack query: everything but the direction and the spectrum.
-#[derive(Clone, Debug, PartialEq)]
-pub struct StackQuery {
-    /// The stack (its exterior above, `z > 0`).
-    pub stack: Stack,
-    /// Which lobes to compute.
-    pub want: Want,
-    /// Only `M00`.
-    pub output: Output,
-    /// The exit medium absorbs whatever enters it: no transmission lobe, no light from below.
-    pub absorbing_exit: bool,
-}
+pub type StackQuery = ThinQuery<Stack>;
 
 impl StackQuery {
     /// A query of `stack` (validated by [`Stack::new`]).
     pub fn new(stack: Stack, reflection: bool, transmission: bool, intensity_only: bool) -> Self {
-        StackQuery {
-            stack,
-            want: Want {
-                reflection,
-                transmission,
-            },
-            output: if intensity_only {
-                Output::Intensity
-            } else {
-                Output::Mueller
-            },
-            absorbing_exit: false,
-        }
-    }
-
-    /// The same query with an absorbing exit medium or not.
-    pub fn with_absorbing_exit(self, absorbing_exit: bool) -> Self {
-        StackQuery {
-            absorbing_exit,
-            ..self
-        }
+        ThinQuery::of(stack, reflection, transmission, intensity_only)
     }
 }
 
@@ -76,62 +42,22 @@ pub fn stack_lobes_full(
     thin::lobes(q, spectrum, wi, transport, false)
 }
 
-impl Thin for StackQuery {
-    fn want(&self) -> Want {
-        self.want
-    }
-
-    fn output(&self) -> Output {
-        self.output
-    }
-
-    fn absorbing_exit(&self) -> bool {
-        self.absorbing_exit
-    }
+impl Thin for Stack {
+    type Model<'a> = StackModel<'a>;
 
     fn ext(&self) -> f64 {
-        self.stack.ext.re
+        self.ext.re
     }
 
     fn exit(&self) -> f64 {
-        self.stack.exit.re
+        self.exit.re
     }
 
     fn flipped(&self) -> Self {
-        StackQuery {
-            stack: self.stack.flipped(),
-            ..self.clone()
-        }
+        Stack::flipped(self)
     }
 
-    fn evaluate(
-        &self,
-        spectrum: &Spectrum,
-        frame: PlaneFrame,
-        beta: C64,
-        want: Want,
-    ) -> Result<Vec<SlabMueller>> {
-        let model = StackModel::new(&self.stack, frame, beta);
-        match *spectrum {
-            Spectrum::Weights(set) => Ok(model
-                .channels(set, want, self.output, Accuracy::Perceptual)?
-                .to_vec()),
-            _ => spectrum
-                .bands()
-                .into_iter()
-                .map(|(wavelength_nm, fwhm_nm)| {
-                    if is_exact_band(fwhm_nm, wavelength_nm) {
-                        model.at(wavelength_nm, want, self.output)
-                    } else {
-                        model.band(
-                            &narrow_band(wavelength_nm, fwhm_nm),
-                            want,
-                            self.output,
-                            Accuracy::Perceptual,
-                        )
-                    }
-                })
-                .collect(),
-        }
+    fn model(&self, frame: PlaneFrame, beta: C64) -> StackModel<'_> {
+        StackModel::new(self, frame, beta)
     }
 }
