@@ -13,11 +13,11 @@
 //! decides them:
 //!
 //! * `intensity_only` (`PlateCall::intensity_only`, set by the plugin in the unpolarised variants;
-//!   `Output::Intensity` in `spectral::integrate::band_sum`): only `M00` of each path-class pair
+//!   `Output::Intensity` in `spectral::gaussian::band_sum`): only `M00` of each path-class pair
 //!   instead of the full coherency matrix. Full = the same query with `Output::Mueller`. It acts
 //!   only where the closed-form path sum runs (band-filtered or RGB queries of plates too thick
 //!   for quadrature); timed on a 1000 um plate through a 4 nm band (`Spectrum::Band`).
-//! * `incoherent_thick_plate` (`coherent_order` in `spectral::integrate`: at most `THICK_ORDER`
+//! * `incoherent_thick_plate` (`coherent_order` in `spectral::gaussian`: at most `THICK_ORDER`
 //!   coherent round trips plus the closed-form incoherent tail when one round trip exceeds the
 //!   coherence length). Full = the coherent path sum to the order where the round-trip
 //!   amplitude falls below `ORDER_TOLERANCE` for that query (the order the core uses for plates
@@ -46,10 +46,13 @@ use birefringent::params::Thickness;
 use birefringent::plate::slab::Output;
 use birefringent::plate::slab::Want;
 use birefringent::plate::Plate;
+use birefringent::quadrature::Accuracy;
 use birefringent::render::crystal::crystal_lobes;
-use birefringent::render::plate::{plate_lobes, PlateQuery, Spectrum};
+use birefringent::render::plate::{plate_lobes, PlateQuery};
+use birefringent::render::thin::Spectrum;
 use birefringent::render::Transport;
-use birefringent::spectral::integrate::{integrate_with, Method};
+use birefringent::spectral::gaussian::{band_with, Method};
+use birefringent::spectral::model::{PlateModel, ThinModel};
 use birefringent::C64;
 use nalgebra::Vector3;
 use serde_json::{json, Value};
@@ -224,10 +227,10 @@ fn main() {
     );
     results.insert("intensity_only/1um_band4nm".into(), r);
 
-    // Incoherent thick plate: Auto (THICK_ORDER + tail) vs the coherent sum to ORDER_TOLERANCE.
+    // Incoherent thick plate: the route (THICK_ORDER + tail) vs the coherent sum to ORDER_TOLERANCE.
     for (thick, panels_too) in [(1000.0, false), (100.0, true)] {
         let q = query(aniso, thick, axis, both, false);
-        let plate = q.plate;
+        let plate = q.element;
         let orders = full_orders(&plate, &inp);
         let n = *orders.iter().max().unwrap_or(&0);
         let mean_order = orders.iter().sum::<usize>() as f64 / orders.len() as f64;
@@ -242,23 +245,31 @@ fn main() {
                 (2.0 * osc).ceil() as usize
             })
             .collect();
-        // 0: Auto; 1: the coherent path sum; 2: quadrature panels.
+        // 0: the route; 1: the coherent path sum; 2: quadrature panels.
         let run = |which: u8| {
             let inp = &inp;
             let (orders, panels) = (&orders, &panels);
             move |i: usize| {
-                let method = match which {
-                    0 => Method::Auto,
-                    1 => Method::Paths(Some(orders[i])),
-                    _ => Method::Panels(panels[i]),
-                };
                 let (wi, lambda) = inp[i];
                 let frame = PlaneFrame::from_direction(wi);
                 let beta = plate.ext * (wi.x * wi.x + wi.y * wi.y).sqrt();
                 let band = [narrow_band(lambda, 4.0)];
+                let method = match which {
+                    // The route's own choice.
+                    0 => {
+                        let model = PlateModel::new(&plate, frame, beta);
+                        black_box(
+                            model
+                                .band(&band, both, Output::Mueller, Accuracy::Perceptual)
+                                .unwrap(),
+                        );
+                        return;
+                    }
+                    1 => Method::Paths(Some(orders[i])),
+                    _ => Method::Panels(panels[i]),
+                };
                 black_box(
-                    integrate_with(&plate, &frame, beta, &band, both, Output::Mueller, method)
-                        .unwrap(),
+                    band_with(&plate, &frame, beta, &band, both, Output::Mueller, method).unwrap(),
                 );
             }
         };

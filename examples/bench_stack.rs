@@ -21,13 +21,14 @@
 #[path = "../tests/stack_spectral.rs"]
 mod stack_spectral;
 
+use birefringent::colour::weights::WeightSet;
 use birefringent::material::Material;
 use birefringent::optics::frame::PlaneFrame;
 use birefringent::params::Thickness;
 use birefringent::plate::slab::{Output, Want};
 use birefringent::plate::Plate;
-use birefringent::spectral::model::{Accuracy, PlateModel};
-use birefringent::spectral::weights::WeightSet;
+use birefringent::quadrature::Accuracy;
+use birefringent::spectral::model::{PlateModel, ThinModel};
 use birefringent::stack::exact::StackBlocks;
 use birefringent::stack::spectral::StackModel;
 use birefringent::stack::{Layer, Stack};

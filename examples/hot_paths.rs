@@ -26,6 +26,7 @@
 //! `angle:quartz:5000:80`: the cases of the spectral integral's profile (issue 20: 0, 45, 80
 //! and 89 degrees; 0, 5 and 150 um).
 
+use birefringent::colour::weights::WeightSet;
 use birefringent::ffi::bridge::{CrystalLanes, Samples, Status, Transport as BridgeTransport};
 use birefringent::ffi::{new_materials, sample_crystal};
 use birefringent::material::Material;
@@ -34,9 +35,9 @@ use birefringent::optics::medium::Uniaxial;
 use birefringent::optics::surface::Surface;
 use birefringent::params::Thickness;
 use birefringent::render::crystal::crystal_lobes;
-use birefringent::render::plate::{plate_lobes, PlateQuery, Spectrum};
+use birefringent::render::plate::{plate_lobes, PlateQuery};
+use birefringent::render::thin::Spectrum;
 use birefringent::render::Transport;
-use birefringent::spectral::weights::WeightSet;
 use birefringent::C64;
 use nalgebra::Vector3;
 use std::hint::black_box;

@@ -1,6 +1,6 @@
 //! A spectral band: a unit-mass Gaussian in wavenumber `k = 2π/λ`, the shape every spectral
 //! weight is made of (a narrow band around one sampled wavelength, or one term of a camera
-//! channel's fit, [`crate::spectral::weights`]).
+//! channel's fit, [`crate::colour::weights`]).
 
 /// One Gaussian term of a fit, in wavenumber `k = 2 pi / lambda` (rad/nm, lambda in nm):
 /// `amplitude * N(k; mu, sigma)` with `N` the unit-mass normal pdf.

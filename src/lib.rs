@@ -8,12 +8,14 @@
 pub mod band;
 pub mod calc;
 pub mod cmath;
+pub mod colour;
 pub mod error;
 pub mod ffi;
 pub mod material;
 pub mod optics;
 pub mod params;
 pub mod plate;
+pub mod quadrature;
 pub mod real;
 pub mod record;
 pub mod render;

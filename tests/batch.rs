@@ -8,6 +8,7 @@
 //! single-value column equals the same value repeated (broadcast); columns of the wrong length
 //! are refused with a message naming them.
 
+use birefringent::colour::weights::WeightSet;
 use birefringent::ffi::bridge::{
     CrystalLanes, PlateCall, PlateLanes, Samples, Status, Transport as T,
 };
@@ -21,10 +22,10 @@ use birefringent::optics::surface::Surface;
 use birefringent::params::{Length, Thickness};
 use birefringent::render::choice::Choice;
 use birefringent::render::crystal::crystal_slots;
-use birefringent::render::plate::{plate_lobes, PlateQuery, Spectrum};
+use birefringent::render::plate::{plate_lobes, PlateQuery};
 use birefringent::render::slots::{crystal_component, Slots, CRYSTAL_SLOTS};
+use birefringent::render::thin::Spectrum;
 use birefringent::render::{PathLobe, Transport};
-use birefringent::spectral::weights::WeightSet;
 use birefringent::C64;
 use nalgebra::Vector3;
 

@@ -3,6 +3,7 @@
 //! band-integrated) against the general slab and the general band integration.
 
 use birefringent::band::narrow_band;
+use birefringent::colour::weights::{gaussians, WeightSet};
 use birefringent::material::Material;
 use birefringent::optics::frame::PlaneFrame;
 use birefringent::optics::interface::Interface;
@@ -13,9 +14,9 @@ use birefringent::plate::etalon::Etalon;
 use birefringent::plate::slab::Output;
 use birefringent::plate::slab::Want;
 use birefringent::plate::Plate;
-use birefringent::spectral::integrate::{integrate_with, Method};
-use birefringent::spectral::model::PlateModel;
-use birefringent::spectral::weights::{gaussians, WeightSet};
+use birefringent::quadrature::Accuracy;
+use birefringent::spectral::gaussian::{band_with, Method};
+use birefringent::spectral::model::{PlateModel, ThinModel};
 use birefringent::C64;
 use nalgebra::{Matrix4, Vector3};
 
@@ -149,14 +150,14 @@ fn etalon_band_equals_the_general_band_integration() {
         let model = PlateModel::new(&plate, frame, beta);
         assert!(model.etalon().is_some());
         let fast = model
-            .band(&band, Want::BOTH, Output::Mueller, &mut None)
+            .band(&band, Want::BOTH, Output::Mueller, Accuracy::Perceptual)
             .unwrap();
         let method = if thick {
             Method::Paths(None)
         } else {
             Method::Panels(200)
         };
-        let full = integrate_with(
+        let full = band_with(
             &plate,
             &frame,
             beta,
@@ -278,7 +279,8 @@ fn isotropic_crystal_lobes_equal_the_full_computation() {
 /// transport modes, both sides, exact, band-filtered and sRGB spectra.
 #[test]
 fn isotropic_plate_lobes_shared_equal_per_lobe_solutions() {
-    use birefringent::render::plate::{plate_lobes, plate_lobes_full, PlateQuery, Spectrum};
+    use birefringent::render::plate::{plate_lobes, plate_lobes_full, PlateQuery};
+    use birefringent::render::thin::Spectrum;
     use birefringent::render::Transport;
     let mut rng = Rng::new(75);
     let (mut worst, mut lobes) = (0.0f64, 0);
@@ -340,7 +342,8 @@ fn isotropic_plate_lobes_shared_equal_per_lobe_solutions() {
 /// one query per wavelength, isotropic plates (one etalon shared) and birefringent ones alike.
 #[test]
 fn several_wavelengths_in_one_query_equal_single_queries() {
-    use birefringent::render::plate::{plate_lobes, PlateQuery, Spectrum, MAX_BANDS};
+    use birefringent::render::plate::{plate_lobes, PlateQuery};
+    use birefringent::render::thin::{Spectrum, MAX_BANDS};
     use birefringent::render::Transport;
     let mut rng = Rng::new(76);
     let mut worst = 0.0f64;
@@ -412,7 +415,8 @@ fn several_wavelengths_in_one_query_equal_single_queries() {
 /// The shared isotropic path validates the wavelengths as the general path does.
 #[test]
 fn isotropic_plate_refuses_invalid_wavelengths() {
-    use birefringent::render::plate::{plate_lobes, PlateQuery, Spectrum};
+    use birefringent::render::plate::{plate_lobes, PlateQuery};
+    use birefringent::render::thin::Spectrum;
     use birefringent::render::Transport;
     let q = PlateQuery::new(
         Material::constant(re(1.5), re(1.5)).unwrap(),

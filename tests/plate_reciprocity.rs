@@ -2,11 +2,12 @@
 //! side by reciprocity (`Q Mᵀ Q`), against an independent method: each lobe solved from its
 //! own light direction (the mirror direction, or the far side), as `plate_lobes_full` does.
 
+use birefringent::colour::weights::WeightSet;
 use birefringent::material::Material;
 use birefringent::params::Thickness;
-use birefringent::render::plate::{plate_lobes, plate_lobes_full, PlateQuery, Spectrum};
+use birefringent::render::plate::{plate_lobes, plate_lobes_full, PlateQuery};
+use birefringent::render::thin::Spectrum;
 use birefringent::render::Transport;
-use birefringent::spectral::weights::WeightSet;
 use birefringent::C64;
 
 mod common;
@@ -128,7 +129,7 @@ fn band_radiance_lobes_are_the_reversed_forward_lobes() {
 }
 
 /// sRGB channels, plates in air up to 72 degrees: each side is integrated to the perceptual
-/// budget (`crate::spectral::budget`) from its own nodes, so the two agree to that budget's
+/// budget (`crate::quadrature::budget`) from its own nodes, so the two agree to that budget's
 /// Mueller-entry scale, not to rounding (measured worst 5.8e-4).
 #[test]
 fn srgb_radiance_lobes_are_the_reversed_forward_lobes() {

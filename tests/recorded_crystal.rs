@@ -212,12 +212,27 @@ impl Lane {
 
     /// The material the lane has: the recipe's, with the lane's inputs.
     fn host_material(&self) -> Material {
-        let (no, ne, ko, ke) = self.eta;
+        let (no, ne, ko, ke) = self.lane_eta();
         match self.kind {
             Kind::Named(name) => Material::named(name, ko, ke),
             _ => Material::constant(C64::new(no, ko), C64::new(ne, ke)),
         }
         .unwrap()
+    }
+
+    /// The indices the lane's crystal has: its inputs, except that a crystal isotropic when
+    /// recorded stays isotropic, its pairs of inputs replaced by their means.
+    fn lane_eta(&self) -> (f64, f64, f64, f64) {
+        let (mut no, mut ne, mut ko, mut ke) = self.eta;
+        if matches!(self.kind, Kind::Isotropic | Kind::Opaque) {
+            if self.inputs.1 {
+                (no, ne) = (0.5 * (no + ne), 0.5 * (no + ne));
+            }
+            if self.inputs.2 {
+                (ko, ke) = (0.5 * (ko + ke), 0.5 * (ko + ke));
+            }
+        }
+        (no, ne, ko, ke)
     }
 
     /// The lane's optic axis.
@@ -231,7 +246,7 @@ impl Lane {
 
     /// True if the lane's crystal is birefringent and absorbing, or its axis zero: refused.
     fn refused(&self) -> bool {
-        let (no, ne, ko, ke) = self.eta;
+        let (no, ne, ko, ke) = self.lane_eta();
         let birefringent = matches!(self.kind, Kind::Named(_)) || no != ne || ko != ke;
         self.zero_axis || (birefringent && (ko > 0.0 || ke > 0.0))
     }
@@ -332,7 +347,9 @@ fn the_recorded_program_equals_the_host_sample() {
     assert!(valid > 1200, "{valid} lanes sample a lobe");
     assert!(inside > 400, "{inside} lanes from inside sample a lobe");
     assert!(slots_seen.iter().all(|&n| n >= 10), "{slots_seen:?}");
-    assert!(refused > 50 && grazing > 10 && isotropy_changed > 50 && absorption_changed > 50);
+    // Refused: a zero optic axis (2 % of the lanes with the axis an input), a birefringent
+    // absorbing lane (an absorbing named crystal).
+    assert!(refused > 20 && grazing > 10 && isotropy_changed > 50 && absorption_changed > 50);
 }
 
 /// The generic sample on `f64` against a scalar route (the slots of each wavelength, then
@@ -459,7 +476,9 @@ fn decisions_known_from_the_recipe_are_made_while_recording() {
     );
     assert!(4 * glass < crystal && 4 * metal < crystal);
     assert!(calcite_4 > 3 * calcite && crystal < calcite);
-    assert!(glass_inputs > crystal_inputs.min(crystal));
+    // An isotropic crystal stays isotropic with its indices as inputs (their mean): its program
+    // keeps the closed form of a dielectric interface.
+    assert!(glass_inputs < 2 * glass && 4 * glass_inputs < crystal_inputs);
 }
 
 /// Extinction carrying derivatives on a birefringent crystal (which cannot absorb) is refused

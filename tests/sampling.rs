@@ -79,7 +79,8 @@ fn isotropic_crystal_weights_are_mitsubas_dielectric_weights() {
 #[test]
 fn intensity_only_plate_queries_return_m00_alone() {
     use birefringent::material::Material;
-    use birefringent::render::plate::{plate_lobes, PlateQuery, Spectrum};
+    use birefringent::render::plate::{plate_lobes, PlateQuery};
+    use birefringent::render::thin::Spectrum;
     let mut rng = Rng::new(33);
     for i in 0..200 {
         let material = if i % 2 == 0 {
@@ -126,7 +127,8 @@ fn intensity_only_plate_queries_return_m00_alone() {
 #[test]
 fn absorbing_exit_keeps_the_front_reflection_only() {
     use birefringent::material::Material;
-    use birefringent::render::plate::{plate_lobes, PlateQuery, Spectrum};
+    use birefringent::render::plate::{plate_lobes, PlateQuery};
+    use birefringent::render::thin::Spectrum;
     let mut rng = Rng::new(34);
     let q = PlateQuery::new(
         Material::named("quartz", 0.0, 0.0).unwrap(),
@@ -174,13 +176,15 @@ fn absorbing_exit_keeps_the_front_reflection_only() {
 /// thin_film scene's scalar_rgb image was 0.06 (in units of the light) too red there.
 #[test]
 fn srgb_lobes_keep_negative_channels() {
+    use birefringent::colour::weights::WeightSet;
     use birefringent::material::Material;
     use birefringent::optics::frame::PlaneFrame;
     use birefringent::plate::slab::Output;
     use birefringent::plate::slab::Want;
-    use birefringent::render::plate::{plate_lobes, PlateQuery, Spectrum};
-    use birefringent::spectral::model::{Accuracy, PlateModel};
-    use birefringent::spectral::weights::WeightSet;
+    use birefringent::quadrature::Accuracy;
+    use birefringent::render::plate::{plate_lobes, PlateQuery};
+    use birefringent::render::thin::Spectrum;
+    use birefringent::spectral::model::{PlateModel, ThinModel};
     let q = PlateQuery::new(
         Material::named("linbo3", 0.0, 0.0).unwrap(),
         0.0,
@@ -201,7 +205,7 @@ fn srgb_lobes_keep_negative_channels() {
     // Radiance: the core solves the plate for light arriving from the reflected direction.
     let wo = Vector3::new(0.0, theta.sin(), theta.cos());
     let direct = PlateModel::new(
-        &q.plate,
+        &q.element,
         PlaneFrame::from_direction(wo),
         C64::new(theta.sin(), 0.0),
     )
@@ -334,7 +338,8 @@ fn absorbing_bulk_surface_is_opaque_like_a_conductor() {
 #[test]
 fn vanishing_bandwidth_is_exact() {
     use birefringent::material::Material;
-    use birefringent::render::plate::{plate_lobes, PlateQuery, Spectrum};
+    use birefringent::render::plate::{plate_lobes, PlateQuery};
+    use birefringent::render::thin::Spectrum;
     let q = PlateQuery::new(
         Material::named("quartz", 0.0, 0.0).unwrap(),
         0.0,

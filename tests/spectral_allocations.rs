@@ -4,14 +4,15 @@
 //! global allocator. The first query of a plate builds what is shared by all queries (rules,
 //! layouts, per-thread working memory), which is no per-query cost.
 
+use birefringent::colour::weights::WeightSet;
 use birefringent::material::Material;
 use birefringent::optics::frame::PlaneFrame;
 use birefringent::plate::slab::{Output, Want};
 use birefringent::plate::Plate;
-use birefringent::spectral::model::{Accuracy, PlateModel};
+use birefringent::quadrature::Accuracy;
+use birefringent::spectral::model::{PlateModel, ThinModel};
 use birefringent::spectral::route::{self, Route};
 use birefringent::spectral::survey::Survey;
-use birefringent::spectral::weights::WeightSet;
 use birefringent::C64;
 use nalgebra::Vector3;
 use std::alloc::{GlobalAlloc, Layout, System};
@@ -53,7 +54,8 @@ fn route_name(r: Route) -> &'static str {
         Route::Envelope(_) => "families",
         Route::Classes(_) => "classes",
         Route::Dense(_) => "dense",
-        Route::Evanescent(_) => "evanescent",
+        Route::Pointwise(_) => "pointwise",
+        Route::Gaussians => "gaussians",
     }
 }
 
@@ -75,9 +77,11 @@ fn channel_queries_allocate_nothing_per_query() {
         let theta: f64 = *theta;
         let frame = PlaneFrame::from_azimuth(0.5);
         let beta = C64::new(theta.to_radians().sin(), 0.0);
-        let name = route_name(
-            route::choose(&Survey::new(p, frame, beta).unwrap(), WeightSet::SrgbD65).unwrap(),
-        );
+        let name = route_name(route::channels(
+            &Survey::new(p, frame, beta).unwrap(),
+            WeightSet::SrgbD65,
+            Accuracy::Perceptual,
+        ));
         seen.push(name);
         let query = || {
             std::hint::black_box(

@@ -9,13 +9,29 @@ use birefringent::optics::frame::PlaneFrame;
 use birefringent::plate::slab::Output;
 use birefringent::plate::slab::Want;
 use birefringent::plate::Plate;
-use birefringent::spectral::integrate::{integrate, integrate_with, quadrature, Method};
+use birefringent::quadrature::Accuracy;
+use birefringent::spectral::gaussian::{band_with, Method};
+use birefringent::spectral::model::{PlateModel, ThinModel};
+use birefringent::spectral::reference::quadrature;
 use birefringent::C64;
 use nalgebra::{Matrix4, Vector3};
 
 mod common;
 use common::band::band_weight;
 use common::Rng;
+
+/// The plate over `band`, each Gaussian on the route's method (what the renderer and the
+/// calculator use).
+fn routed(
+    plate: &Plate,
+    frame: &PlaneFrame,
+    beta: C64,
+    band: &[birefringent::band::Gaussian],
+    want: Want,
+    output: Output,
+) -> birefringent::Result<birefringent::plate::slab::SlabMueller> {
+    PlateModel::new(plate, *frame, beta).band(band, want, output, Accuracy::Perceptual)
+}
 
 fn random_plate(rng: &mut Rng) -> Plate {
     let material = match rng.index(5) {
@@ -45,7 +61,7 @@ fn gaussian_band_closed_form_matches_dense_quadrature() {
         let frame = PlaneFrame::from_azimuth(rng.range(0.0, 6.3));
         let beta = C64::new(rng.range(0.0, 0.9), 0.0);
         let g = narrow_band(center, fwhm);
-        let fast = integrate(&plate, &frame, beta, &[g], Want::BOTH, Output::Mueller).unwrap();
+        let fast = routed(&plate, &frame, beta, &[g], Want::BOTH, Output::Mueller).unwrap();
         // Resolve the fastest oscillation: step << λ² / (largest optical path ~ 2 n d × orders).
         let step = (center * center / (plate.thickness_nm * 40.0)).min(0.05);
         let lo = center - 4.0 * fwhm;
@@ -91,11 +107,11 @@ fn zero_bandwidth_is_the_exact_slab_and_intensity_only_is_m00() {
         let frame = PlaneFrame::from_azimuth(rng.range(0.0, 6.3));
         let beta = C64::new(rng.range(0.0, 0.9), 0.0);
         let g = narrow_band(550.0, 8.0);
-        let full = integrate(&plate, &frame, beta, &[g], Want::BOTH, Output::Mueller).unwrap();
-        let m00 = integrate(&plate, &frame, beta, &[g], Want::BOTH, Output::Intensity).unwrap();
+        let full = routed(&plate, &frame, beta, &[g], Want::BOTH, Output::Mueller).unwrap();
+        let m00 = routed(&plate, &frame, beta, &[g], Want::BOTH, Output::Intensity).unwrap();
         assert!((full.r.unwrap()[(0, 0)] - m00.r.unwrap()[(0, 0)]).abs() < 1e-13);
         assert!((full.t.unwrap()[(0, 0)] - m00.t.unwrap()[(0, 0)]).abs() < 1e-13);
-        let r_only = integrate(
+        let r_only = routed(
             &plate,
             &frame,
             beta,
@@ -128,8 +144,8 @@ fn thick_plate_shortcut_equals_the_full_coherent_sum() {
     let beta = C64::new(0.4, 0.0);
     let g = narrow_band(550.0, 10.0);
     // Auto picks the path classes here (σ D ≫ HERMITE_LIMIT), capped at THICK_ORDER.
-    let fast = integrate(&plate, &frame, beta, &[g], Want::BOTH, Output::Mueller).unwrap();
-    let full = integrate_with(
+    let fast = routed(&plate, &frame, beta, &[g], Want::BOTH, Output::Mueller).unwrap();
+    let full = band_with(
         &plate,
         &frame,
         beta,
@@ -192,7 +208,7 @@ fn grazing_incidence_conserves_energy_and_matches_quadrature() {
         let beta = C64::new(f64::to_radians(deg).sin(), 0.0);
         let center = 600.0;
         let g = narrow_band(center, fwhm);
-        let fast = integrate(&plate, &frame, beta, &[g], Want::BOTH, Output::Mueller).unwrap();
+        let fast = routed(&plate, &frame, beta, &[g], Want::BOTH, Output::Mueller).unwrap();
         let (r, t) = (fast.r.unwrap(), fast.t.unwrap());
         let energy = r[(0, 0)] + t[(0, 0)];
         let step = (center * center / (d * 200.0)).min(0.01);

@@ -3,13 +3,14 @@
 //! (frustrated total reflection) and the Fresnel amplitudes vary much faster across the band
 //! than the indices: against dense quadrature of the exact plate with the tabulated weights.
 
+use birefringent::colour::weights::{fourier_error_bound, weight_per_nm, WeightSet};
 use birefringent::material::Material;
 use birefringent::optics::frame::PlaneFrame;
 use birefringent::params::Thickness;
 use birefringent::plate::slab::{Output, Want};
 use birefringent::plate::Plate;
-use birefringent::spectral::model::{Accuracy, PlateModel};
-use birefringent::spectral::weights::{fourier_error_bound, weight_per_nm, WeightSet};
+use birefringent::quadrature::Accuracy;
+use birefringent::spectral::model::{PlateModel, ThinModel};
 use birefringent::C64;
 use nalgebra::{Matrix4, Vector3};
 

@@ -1,10 +1,10 @@
-//! The interpolated blocks of a dispersive plate (`spectral::interpolate`) against the exact
+//! The interpolated blocks of a dispersive plate (`quadrature::interpolate`) against the exact
 //! blocks (both interfaces solved at the wavenumber) and the plate's Mueller matrices from each.
 
 use birefringent::material::Material;
 use birefringent::optics::frame::PlaneFrame;
 use birefringent::plate::slab::Want;
-use birefringent::spectral::interpolate::BlockInterpolant;
+use birefringent::spectral::pointwise::BlockInterpolant;
 use birefringent::C64;
 
 mod common;

@@ -8,7 +8,7 @@ use birefringent::optics::frame::PlaneFrame;
 use birefringent::plate::slab::Output;
 use birefringent::plate::slab::Want;
 use birefringent::plate::Plate;
-use birefringent::spectral::integrate::{integrate_with, narrow_closed_form, Method};
+use birefringent::spectral::gaussian::{band_with, narrow_closed_form, Method};
 use birefringent::C64;
 
 mod common;
@@ -46,7 +46,7 @@ fn narrow_closed_form_matches_quadrature_of_the_exact_plate() {
         // Panels: 2 per oscillation of the round trip over ±6.5σ, at least 40 (320 nodes).
         let osc = 13.0 * g.sigma * plate.thickness_nm * 4.0 / std::f64::consts::TAU;
         let panels = ((2.0 * osc).ceil() as usize).clamp(40, 4000);
-        let full = integrate_with(
+        let full = band_with(
             &plate,
             &frame,
             beta,

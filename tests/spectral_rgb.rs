@@ -32,13 +32,15 @@
 //! (`--validate N`), which includes this file as a module.
 #![allow(dead_code)]
 
+use birefringent::colour::convert::{ciede2000, xyz_to_lab};
+use birefringent::colour::weights::{gaussians, weight_per_nm, WeightSet};
 use birefringent::material::{Index, Material};
 use birefringent::optics::frame::PlaneFrame;
 use birefringent::plate::slab::Output;
 use birefringent::plate::slab::{SlabMueller, Want};
 use birefringent::plate::Plate;
-use birefringent::spectral::model::{Accuracy, PlateModel};
-use birefringent::spectral::weights::{ciede2000, gaussians, weight_per_nm, xyz_to_lab, WeightSet};
+use birefringent::quadrature::Accuracy;
+use birefringent::spectral::model::{PlateModel, ThinModel};
 use birefringent::C64;
 use nalgebra::Vector3;
 use std::time::Instant;
@@ -270,6 +272,46 @@ pub fn extended_cases(n: usize, seed: u64) -> Vec<Case> {
     (0..n).map(|i| random_extended_case(&mut rng, i)).collect()
 }
 
+/// The `index`-th plate of the near-grazing hard set (issue 30): half of them rutile, sapphire,
+/// lithium niobate or calcite of 3-17 µm at 79-86°, half a named crystal 50-500 µm thick at
+/// 88.5-89.5°; random optic axis and azimuth, air on both sides.
+pub fn random_hard_case(rng: &mut Rng, index: usize) -> Case {
+    let (name, thickness_nm, theta_deg) = if index.is_multiple_of(2) {
+        let names = ["rutile", "sapphire", "linbo3", "calcite"];
+        (
+            names[rng.index(names.len())],
+            rng.range(3e3, 17e3),
+            rng.range(79.0, 86.0),
+        )
+    } else {
+        (
+            CRYSTALS[rng.index(CRYSTALS.len())],
+            rng.range(50e3, 500e3),
+            rng.range(88.5, 89.5),
+        )
+    };
+    Case {
+        index,
+        kind: Kind::Crystal(name),
+        plate: Plate {
+            material: Material::named(name, 0.0, 0.0).unwrap(),
+            birefringence: 0.0,
+            ext: C64::new(1.0, 0.0),
+            exit: C64::new(1.0, 0.0),
+            axis: rng.unit_vector(),
+            thickness_nm,
+        },
+        theta_deg,
+        phi_deg: rng.range(0.0, 360.0),
+    }
+}
+
+/// The first `n` cases of the near-grazing hard set of seed `seed`.
+pub fn hard_cases(n: usize, seed: u64) -> Vec<Case> {
+    let mut rng = Rng::new(seed);
+    (0..n).map(|i| random_hard_case(&mut rng, i)).collect()
+}
+
 /// `[crossed, parallel, reflection]` of one pair of Mueller matrices (see the module docs).
 pub fn quantities(m: &SlabMueller) -> [f64; 3] {
     let t = m.t.expect("transmission");
@@ -336,6 +378,17 @@ pub fn quadrature_step(case: &Case) -> f64 {
     (s / (16.0 * plate.thickness_nm)).min(0.5) * (1.0 - round_trip_reflectance(case)).max(1e-3)
 }
 
+/// The quadrature step of the near-grazing hard set: [`quadrature_step`], and at most a tenth
+/// of the internal-reflection fringes' spacing `λ² cos θ / (2 n_g d)` at 360 nm (θ the
+/// incidence, `n_g` the largest group index there; issue 30), at least 1e-5 nm.
+pub fn hard_quadrature_step(case: &Case) -> f64 {
+    let plate = &case.plate;
+    let grazing = RANGE.0 * RANGE.0 * case.theta_deg.to_radians().cos()
+        / (2.0 * group_index(&plate.material, RANGE.0).max(1.0) * plate.thickness_nm)
+        / 10.0;
+    quadrature_step(case).min(grazing).max(1e-5)
+}
+
 /// The largest `‖r₃‖ ‖r₂‖` (spectral norms of the internal reflections at the top and bottom
 /// faces: the largest singular value of each, from the eigenvalues of `rᴴr`) at 9 wavelengths
 /// across the range.
@@ -361,7 +414,7 @@ fn round_trip_reflectance(case: &Case) -> f64 {
 }
 
 /// Dense quadrature of the exact plate: the trapezoid rule of
-/// [`birefringent::spectral::integrate::quadrature`] (same nodes, same weights), with one
+/// [`birefringent::spectral::reference::quadrature`] (same nodes, same weights), with one
 /// evaluation of the plate per wavelength shared by the three channels and quantities.
 pub struct Reference {
     /// With the tabulated weights (`weight_per_nm`): the reference.
@@ -462,10 +515,15 @@ pub struct Outcome {
 
 /// Runs one case.
 pub fn compare(case: &Case, with_fitted: bool) -> Outcome {
+    compare_with_step(case, quadrature_step(case), with_fitted)
+}
+
+/// [`compare`] with the reference's step `step_nm`.
+pub fn compare_with_step(case: &Case, step_nm: f64, with_fitted: bool) -> Outcome {
     let t0 = Instant::now();
     let analytic = analytic(case);
     let t1 = Instant::now();
-    let reference = reference(case, quadrature_step(case), with_fitted);
+    let reference = reference(case, step_nm, with_fitted);
     let t2 = Instant::now();
     let de = std::array::from_fn(|q| delta_e(analytic[q], reference.tabulated[q]));
     let de_fitted = reference
@@ -661,7 +719,7 @@ fn single_pass_reference_is_the_library_quadrature() {
         let step = quadrature_step(&case).max(0.05);
         let ours = reference(&case, step, false);
         for c in 0..3 {
-            let lib = birefringent::spectral::integrate::quadrature(
+            let lib = birefringent::spectral::reference::quadrature(
                 &case.plate,
                 &case.frame(),
                 case.beta(),

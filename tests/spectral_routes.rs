@@ -2,21 +2,22 @@
 //! route sends it (`spectral::route`), against a dense quadrature of the exact plate with the
 //! fitted Gaussian weights themselves as the spectrum: that isolates each method's own error
 //! from the fit's (which `tests/spectral_rgb.rs` measures in CIEDE2000). Each approximation of
-//! a method is held to 1e-5 of the white response (`spectral::budget`); several add up, so every
+//! a method is held to 1e-5 of the white response (`quadrature::budget`); several add up, so every
 //! Mueller entry of every channel must agree within 1e-4. Also: a plate of zero thickness is
 //! the bare interface it reduces to, to rounding.
 
 mod common;
 
+use birefringent::colour::weights::{fit_per_wavenumber, gaussians, WeightSet};
 use birefringent::material::Material;
 use birefringent::optics::frame::PlaneFrame;
 use birefringent::optics::fresnel::Fresnel;
 use birefringent::plate::slab::{Output, SlabMueller, Want};
 use birefringent::plate::Plate;
-use birefringent::spectral::model::{Accuracy, PlateModel};
+use birefringent::quadrature::Accuracy;
+use birefringent::spectral::model::{PlateModel, ThinModel};
 use birefringent::spectral::route::{self, Route};
 use birefringent::spectral::survey::Survey;
-use birefringent::spectral::weights::{fit_per_wavenumber, gaussians, WeightSet};
 use birefringent::C64;
 use nalgebra::{Matrix4, Vector3};
 use std::f64::consts::TAU;
@@ -91,7 +92,11 @@ fn analytic(p: &Plate, theta_deg: f64) -> [SlabMueller; 3] {
 
 fn route_of(p: &Plate, theta_deg: f64) -> Route {
     let (frame, beta) = incidence(theta_deg);
-    route::choose(&Survey::new(p, frame, beta).unwrap(), SET).unwrap()
+    route::channels(
+        &Survey::new(p, frame, beta).unwrap(),
+        SET,
+        Accuracy::Perceptual,
+    )
 }
 
 /// The largest difference of any Mueller entry of either lobe over the channels.
@@ -151,7 +156,8 @@ fn each_route_matches_dense_quadrature_with_the_fitted_weights() {
             Route::Envelope(_) => "families",
             Route::Classes(_) => "classes",
             Route::Dense(_) => "dense",
-            Route::Evanescent(_) => "evanescent",
+            Route::Pointwise(_) => "pointwise",
+            Route::Gaussians => "gaussians",
         };
         let d = p.thickness_nm * 1e-3;
         assert_eq!(name, expected, "route of {d} um at {theta} deg: {r:?}");
@@ -228,8 +234,8 @@ fn a_weakly_absorbing_plate_turning_evanescent_takes_the_evanescent_route() {
     let (clear, weak) = (plate(0.0), plate(1e-20));
     let survey = Survey::new(&weak, frame, beta).unwrap();
     assert!(matches!(
-        route::choose(&survey, SET).unwrap(),
-        Route::Evanescent(_)
+        route::channels(&survey, SET, Accuracy::Perceptual),
+        Route::Pointwise(_)
     ));
     for (a, b) in channels(&clear).iter().zip(&channels(&weak)) {
         for (x, y) in [(a.r, b.r), (a.t, b.t)] {
@@ -270,4 +276,56 @@ fn a_dichroic_plate_keeps_the_clear_modes_round_trips() {
         println!("dichroic 5 um at 60 deg, {name}, axis {axis:?}: worst |dM| {e:.2e}");
         assert!(e < 1e-4, "{name}, axis {axis:?}: {e:e}");
     }
+}
+
+/// The survey's round-trip decay bounds every power of the round trip `D = r₃ P↑ r₂ P↓` at its
+/// amplitude nodes, `‖Dⁿ‖ ≤ C ρⁿ` (here to `n = 40`, beyond the 8 powers the survey takes), on a
+/// plate near grazing incidence whose single round trip's norm exceeds 1 while the round trips
+/// decay (calcite 90.4 µm at 89.489°): there `ρ < 1` and `C > 1` (without the transient `C`,
+/// `ρⁿ` alone would not bound the first powers; with `ρ` from `‖D‖`, the orders would not
+/// converge).
+#[test]
+fn round_trip_decay_bounds_every_power() {
+    use birefringent::quadrature::{fringe, nodes};
+    let p = Plate {
+        axis: Vector3::new(0.3, -0.5, 0.8).normalize(),
+        ..plate(Material::named("calcite", 0.0, 0.0).unwrap(), 90.4e3, 1.0)
+    };
+    let frame = PlaneFrame::from_azimuth(182.26f64.to_radians());
+    let beta = C64::new(89.489f64.to_radians().sin(), 0.0);
+    let s = Survey::new(&p, frame, beta).unwrap();
+    assert!(s.rho < 1.0, "ρ = {}", s.rho);
+    // The largest singular value of a 2x2 matrix.
+    let norm = |m: &nalgebra::Matrix2<C64>| {
+        let h = m.adjoint() * m;
+        let (tr, det) = (h.trace().re, h.determinant().re);
+        (0.5 * (tr + (tr * tr - 4.0 * det).max(0.0).sqrt())).sqrt()
+    };
+    let (k0, a) = fringe::band();
+    let lv = nodes::level(s.amplitudes.level);
+    let mut first = 0.0f64;
+    for (&j, t) in lv.in_finest.iter().zip(&lv.nodes) {
+        let b = s.amplitudes.exact(j).unwrap();
+        let (pd, pu) = b.propagation(TAU / (k0 + a * t));
+        let diag = |p: [C64; 2]| {
+            nalgebra::Matrix2::new(p[0], C64::new(0.0, 0.0), C64::new(0.0, 0.0), p[1])
+        };
+        let d = b.r3 * diag(pu) * b.r2 * diag(pd);
+        first = first.max(norm(&d));
+        let mut dn = d;
+        for n in 1..=40 {
+            let bound = s.transient * s.rho.powi(n);
+            assert!(
+                norm(&dn) <= bound * (1.0 + 1e-9),
+                "‖D^{n}‖ = {} > C ρ^n = {bound}",
+                norm(&dn)
+            );
+            dn *= d;
+        }
+    }
+    assert!(
+        first > 1.0 && s.transient > 1.0,
+        "‖D‖ = {first}, C = {}",
+        s.transient
+    );
 }

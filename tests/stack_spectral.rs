@@ -19,12 +19,14 @@
 //! round trip. The same code is the validation run of `examples/bench_stack.rs`.
 #![allow(dead_code)]
 
+use birefringent::colour::convert::{ciede2000, xyz_to_lab};
+use birefringent::colour::weights::{weight_per_nm, WeightSet};
 use birefringent::material::Material;
 use birefringent::optics::frame::PlaneFrame;
 use birefringent::params::Thickness;
 use birefringent::plate::slab::{Output, SlabMueller, Want};
-use birefringent::spectral::model::Accuracy;
-use birefringent::spectral::weights::{ciede2000, weight_per_nm, xyz_to_lab, WeightSet};
+use birefringent::quadrature::Accuracy;
+use birefringent::spectral::model::ThinModel;
 use birefringent::stack::exact::StackBlocks;
 use birefringent::stack::spectral::StackModel;
 use birefringent::stack::{Layer, Stack};

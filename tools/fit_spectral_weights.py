@@ -7,7 +7,7 @@ Run from the repository root, inside a virtual environment that has
     python -m venv /tmp/venv && /tmp/venv/bin/pip install -r tools/requirements-tools.txt
     /tmp/venv/bin/python tools/fit_spectral_weights.py
 
-It writes ``src/spectral/weights_data.rs`` (overwriting it) and prints a fit
+It writes ``src/colour/data.rs`` (overwriting it) and prints a fit
 report to standard output.  The script is deterministic: all randomness comes
 from a seeded ``numpy.random.Generator`` (one stream per channel), BLAS is
 forced single-threaded, and the optimiser is deterministic (the last digits
@@ -116,7 +116,7 @@ SIGMA_MAX = 6.0e-3
 RIDGE = 1.0e-6  # tiny amplitude penalty: keeps cancelling pairs bounded
 
 REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-OUTPUT = os.path.join(REPO_ROOT, "src", "spectral", "weights_data.rs")
+OUTPUT = os.path.join(REPO_ROOT, "src", "colour", "data.rs")
 
 
 # --------------------------------------------------------------------------

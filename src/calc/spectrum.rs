@@ -1,6 +1,6 @@
 //! `birefringence slab` with a `spectrum`: Mueller matrices integrated over camera channel
 //! weights or over a Gaussian band, in closed form ("analytic": what the renderer uses, to the
-//! perceptual budget of `spectral::budget` over channels; "exact": every approximation below
+//! perceptual budget of `quadrature::budget` over channels; "exact": every approximation below
 //! 1e-5 of the fitted weights) or by dense quadrature of the exact slab ("quadrature", the
 //! reference).
 
@@ -8,13 +8,14 @@ use super::input::Fields;
 use super::output::num;
 use super::slab::{matrix, read, SlabQuery};
 use crate::band::{is_exact_band, narrow_band, Gaussian};
+use crate::colour::weights::{weight_per_nm, WeightSet};
 use crate::error::{Error, Result};
 use crate::params::Bandwidth;
 use crate::plate::slab::Output;
 use crate::plate::slab::{SlabMueller, Want};
-use crate::spectral::integrate::quadrature;
-use crate::spectral::model::{Accuracy, PlateModel};
-use crate::spectral::weights::{weight_per_nm, WeightSet};
+use crate::quadrature::Accuracy;
+use crate::spectral::model::{PlateModel, ThinModel};
+use crate::spectral::reference::quadrature;
 use nalgebra::{Matrix4, Vector4};
 use serde_json::{json, Map, Value};
 
@@ -217,7 +218,7 @@ fn band(q: &SlabQuery, b: f64, quad: bool, step: Option<f64>) -> Result<SlabMuel
             &[g],
             Want::BOTH,
             Output::Mueller,
-            &mut None,
+            Accuracy::Exact,
         );
     }
     let range = band_range(q.wavelength_nm, b);

@@ -9,12 +9,13 @@ use super::spectrum::{
     band_range, band_weight, channel_names, encode, read_request, step_field, Over, RANGE,
 };
 use crate::band::{is_exact_band, narrow_band};
+use crate::colour::weights::weight_per_nm;
 use crate::error::{Error, Result};
 use crate::optics::frame::PlaneFrame;
 use crate::optics::surface::Surface;
 use crate::params::{Length, Thickness};
 use crate::plate::slab::{Output, SlabMueller, Want};
-use crate::spectral::weights::weight_per_nm;
+use crate::spectral::model::ThinModel;
 use crate::stack::exact::StackBlocks;
 use crate::stack::spectral::{quadrature, StackModel};
 use crate::stack::{in_layer, Layer, Stack};
@@ -201,7 +202,7 @@ fn spectrum(q: &StackInput, spec: &Value) -> Result<Value> {
                 )
                 .map_err(step_field)?]
             } else {
-                vec![model.band(&g, Want::BOTH, Output::Mueller, request.accuracy)?]
+                vec![model.band(&[g], Want::BOTH, Output::Mueller, request.accuracy)?]
             }
         }
     };

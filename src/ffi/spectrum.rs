@@ -1,9 +1,9 @@
 //! The tagged spectrum of a plate query.
 
+use crate::colour::channel::{self, Channel};
+use crate::colour::weights::WeightSet;
 use crate::error::{Error, Result};
-use crate::render::plate::{Spectrum, MAX_BANDS};
-use crate::spectral::channel::{self, Channel};
-use crate::spectral::weights::WeightSet;
+use crate::render::thin::{Spectrum, MAX_BANDS};
 
 /// What a plate query integrates over (see `bridge::PlateSpectrum`).
 #[derive(Clone, Copy, Debug, PartialEq)]

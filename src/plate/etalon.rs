@@ -103,34 +103,42 @@ impl Etalon {
         self.assemble(&b, &s, want, output)
     }
 
+    /// The terms the band average over the unit-mass Gaussian `g` sums ([`Etalon::band`]): the
+    /// first `Δ` where `max|ρ|^Δ g(Δ)` falls below `SERIES_TOLERANCE`; `None` beyond
+    /// `MAX_TERMS` (4096: thin plates near grazing incidence, `|ρ| → 1` with little band damping).
+    pub fn band_terms(&self, g: &Gaussian) -> Option<usize> {
+        let a = 2.0 * (g.sigma * self.thickness_nm * self.w).powi(2);
+        let largest = self.rho[0].norm().max(self.rho[1].norm());
+        // ln(max|ρ|^Δ g(Δ)) = Δ ln max|ρ| − a Δ²: decreasing in Δ.
+        let log = |d: f64| d * largest.ln() - a * d * d;
+        let tolerance = SERIES_TOLERANCE.ln();
+        (1..=MAX_TERMS).find(|&d| log(d as f64) < tolerance)
+    }
+
     /// Mueller matrices averaged over the unit-mass Gaussian band `g` (in wavenumber);
-    /// `None` if the series would need more than `MAX_TERMS` (4096) terms.
+    /// `None` if the series would need more than `MAX_TERMS` (4096) terms
+    /// ([`Etalon::band_terms`]).
     pub fn band(&self, g: &Gaussian, want: Want, output: Output) -> Option<SlabMueller> {
+        let terms = self.band_terms(g)?;
         let h = self.round_trip(g.mu);
         let a = 2.0 * (g.sigma * self.thickness_nm * self.w).powi(2);
         let rh = [self.rho[0] * h, self.rho[1] * h];
-        let largest = self.rho[0].norm().max(self.rho[1].norm());
         // Partial sums P_x = Σ_{Δ≥1} g(Δ) (ρ_x h)^Δ and Q_x = Σ_{j≥0} g(j+1) (ρ_x h)^j.
         let (mut p, mut q) = ([C64::new(0.0, 0.0); 2], [C64::new(0.0, 0.0); 2]);
         let mut power = [C64::new(1.0, 0.0); 2]; // (ρ_x h)^(Δ−1)
         let (mut gd, step, mut ratio) = (1.0f64, (-2.0 * a).exp(), (-a).exp());
-        let mut envelope = 1.0f64;
-        for _ in 1..=MAX_TERMS {
+        for _ in 1..=terms {
             gd *= ratio; // g(Δ) = exp(−a Δ²), by g(Δ) = g(Δ−1) exp(−a (2Δ − 1))
             ratio *= step;
-            envelope *= largest;
             for x in 0..2 {
                 q[x] += power[x] * gd;
                 power[x] *= rh[x];
                 p[x] += power[x] * gd;
             }
-            if envelope * gd < SERIES_TOLERANCE {
-                let b = |x: usize, y: usize| 1.0 + p[y] + p[x].conj();
-                let s = |y: usize| h * q[y];
-                return Some(self.assemble(&b, &s, want, output));
-            }
         }
-        None
+        let b = |x: usize, y: usize| 1.0 + p[y] + p[x].conj();
+        let s = |y: usize| h * q[y];
+        Some(self.assemble(&b, &s, want, output))
     }
 
     /// True if orders one round trip apart keep no coherence over `g` (`g(1) < e^{-40}`): the

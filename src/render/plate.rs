@@ -2,117 +2,26 @@
 //! them, over one wavelength, a band or a set of colour channels (see [`crate::render`] for the
 //! transport modes, [`crate::render::thin`] for the lobes of a thin element).
 
-use crate::band::{is_exact_band, narrow_band};
 use crate::error::{Error, Result};
 use crate::material::check_clear_index;
-use crate::material::{check_wavelength, Material};
+use crate::material::Material;
 use crate::optics::frame::PlaneFrame;
 use crate::optics::medium::Uniaxial;
-use crate::params::{Bandwidth, Thickness};
+use crate::params::Thickness;
 use crate::plate::slab::{Output, SlabMueller, Want};
 use crate::plate::Plate;
 use crate::real::complex::Cx;
 use crate::real::{Real, Select};
 use crate::render::choice::{self, Sampled};
 use crate::render::slots::{plate_component, Slots, PLATE_SLOTS};
-use crate::render::thin::{self, Thin};
+use crate::render::thin::{self, Element, Spectrum, Thin, ThinQuery, MAX_BANDS};
 use crate::render::{PathLobe, Transport};
-use crate::spectral::model::{Accuracy, PlateModel};
-use crate::spectral::weights::WeightSet;
+use crate::spectral::model::PlateModel;
 use nalgebra::Vector3;
 use num_complex::Complex64 as C64;
 
 /// A plate query: everything but the direction and the spectrum.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PlateQuery {
-    /// The plate (top = the exterior side, `z > 0`).
-    pub plate: Plate,
-    /// Which lobes to compute.
-    pub want: Want,
-    /// Only `M00`.
-    pub output: Output,
-    /// The exit medium absorbs whatever enters it (a film on a black substrate): no
-    /// transmission lobe, and no light from below (it cannot reach the plate).
-    pub absorbing_exit: bool,
-}
-
-/// Over which spectrum a plate query is evaluated.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Spectrum {
-    /// One wavelength: exact if `fwhm_nm == 0`, else a Gaussian band of that FWHM (closed form).
-    Band {
-        /// Centre wavelength (nm).
-        wavelength_nm: f64,
-        /// Full width at half maximum (nm).
-        fwhm_nm: f64,
-    },
-    /// Every channel of a weight set (closed form).
-    Weights(WeightSet),
-    /// The first `count` (at most [`MAX_BANDS`]) wavelengths of `wavelengths_nm`, each as
-    /// [`Spectrum::Band`] with the same `fwhm_nm`: the wavelengths a spectral renderer traces
-    /// along one path, answered in one query (a plate's wavelength-independent work is shared).
-    Bands {
-        /// Centre wavelengths (nm).
-        wavelengths_nm: [f64; MAX_BANDS],
-        /// How many of them are used.
-        count: usize,
-        /// Full width at half maximum (nm).
-        fwhm_nm: f64,
-    },
-}
-
-/// Most wavelengths of one [`Spectrum::Bands`] query (Mitsuba's spectral variants trace 4).
-pub const MAX_BANDS: usize = 4;
-
-impl Spectrum {
-    /// True if a channel's weight can be negative (linear sRGB: out-of-gamut colours give a
-    /// negative channel value, which is the colour, not an error).
-    pub(crate) fn is_signed(&self) -> bool {
-        matches!(self, Spectrum::Weights(set) if set.is_signed())
-    }
-
-    /// Channels of the answer.
-    pub(crate) fn channels(&self) -> Result<usize> {
-        match *self {
-            Spectrum::Band { .. } => Ok(1),
-            Spectrum::Weights(_) => Ok(3),
-            Spectrum::Bands { count, .. } if (1..=MAX_BANDS).contains(&count) => Ok(count),
-            Spectrum::Bands { count, .. } => Err(Error::new(
-                "count",
-                format!("must be 1 to {MAX_BANDS} wavelengths, got {count}"),
-            )),
-        }
-    }
-
-    /// Checks every band's wavelength and `filter_bandwidth` ([`Bandwidth`]), once per query.
-    pub(crate) fn validate(&self) -> Result<()> {
-        for (wavelength_nm, fwhm_nm) in self.bands() {
-            check_wavelength(wavelength_nm)?;
-            Bandwidth::new("filter_bandwidth", fwhm_nm, wavelength_nm)?;
-        }
-        Ok(())
-    }
-
-    /// The single bands `(wavelength_nm, fwhm_nm)` of a [`Spectrum::Band`] or
-    /// [`Spectrum::Bands`] (empty for weights).
-    pub(crate) fn bands(&self) -> Vec<(f64, f64)> {
-        match *self {
-            Spectrum::Band {
-                wavelength_nm,
-                fwhm_nm,
-            } => vec![(wavelength_nm, fwhm_nm)],
-            Spectrum::Bands {
-                wavelengths_nm,
-                count,
-                fwhm_nm,
-            } => wavelengths_nm[..count.min(MAX_BANDS)]
-                .iter()
-                .map(|&l| (l, fwhm_nm))
-                .collect(),
-            Spectrum::Weights(_) => Vec::new(),
-        }
-    }
-}
+pub type PlateQuery = ThinQuery<Plate>;
 
 impl PlateQuery {
     /// A validated query.
@@ -136,27 +45,12 @@ impl PlateQuery {
             axis: Uniaxial::new(C64::new(1.0, 0.0), C64::new(1.5, 0.0), axis)?.axis,
             thickness_nm: thickness.nm(),
         };
-        Ok(PlateQuery {
+        Ok(ThinQuery::of(
             plate,
-            want: Want {
-                reflection,
-                transmission,
-            },
-            output: if intensity_only {
-                Output::Intensity
-            } else {
-                Output::Mueller
-            },
-            absorbing_exit: false,
-        })
-    }
-
-    /// The same query with an absorbing exit medium or not ([`PlateQuery::absorbing_exit`]).
-    pub fn with_absorbing_exit(self, absorbing_exit: bool) -> Self {
-        PlateQuery {
-            absorbing_exit,
-            ..self
-        }
+            reflection,
+            transmission,
+            intensity_only,
+        ))
     }
 }
 
@@ -183,103 +77,28 @@ pub fn plate_lobes_full(
     thin::lobes(q, spectrum, wi, transport, false)
 }
 
-impl PlateQuery {
-    /// The plate seen from below: exterior and exit swapped, mirrored through `z = 0`.
-    fn flipped(&self) -> Self {
-        let mut q = *self;
-        q.plate.ext = self.plate.exit;
-        q.plate.exit = self.plate.ext;
-        q.plate.axis.z = -q.plate.axis.z;
-        q
-    }
-}
-
-impl Thin for PlateQuery {
-    type Spectrum = Spectrum;
-
-    fn channels(spectrum: &Spectrum) -> Result<usize> {
-        let channels = spectrum.channels()?;
-        spectrum.validate()?;
-        Ok(channels)
-    }
-
-    fn is_signed(spectrum: &Spectrum) -> bool {
-        spectrum.is_signed()
-    }
-
-    fn oriented(&self, below: bool) -> Self {
-        if below {
-            self.flipped()
-        } else {
-            *self
-        }
-    }
-
-    fn want(&self) -> Want {
-        self.want
-    }
-
-    fn output(&self) -> Output {
-        self.output
-    }
-
-    fn absorbing_exit(&self) -> bool {
-        self.absorbing_exit
-    }
+impl Element for Plate {
+    type Model<'a> = PlateModel<'a>;
 
     fn ext(&self) -> f64 {
-        self.plate.ext.re
+        self.ext.re
     }
 
     fn exit(&self) -> f64 {
-        self.plate.exit.re
+        self.exit.re
     }
 
-    /// Through the plate's model for this incidence (the one decision of [`PlateModel::new`]).
-    fn evaluate(
-        &self,
-        spectrum: &Spectrum,
-        frame: PlaneFrame,
-        beta: C64,
-        want: Want,
-    ) -> Result<Vec<SlabMueller>> {
-        evaluate(
-            &PlateModel::new(&self.plate, frame, beta),
-            spectrum,
-            want,
-            self.output,
-        )
+    fn flipped(&self) -> Self {
+        let mut p = *self;
+        p.ext = self.exit;
+        p.exit = self.ext;
+        p.axis.z = -p.axis.z;
+        p
     }
-}
 
-/// The plate's Mueller matrices (s/p frames) over `spectrum`, per channel, through `model`.
-fn evaluate(
-    model: &PlateModel,
-    spectrum: &Spectrum,
-    want: Want,
-    output: Output,
-) -> Result<Vec<SlabMueller>> {
-    match *spectrum {
-        Spectrum::Weights(set) => Ok(model
-            .channels(set, want, output, Accuracy::Perceptual)?
-            .to_vec()),
-        _ => {
-            // Bands thicker than the coherence length of an isotropic plate share one
-            // incoherent sum.
-            let mut incoherent = None;
-            spectrum
-                .bands()
-                .into_iter()
-                .map(|(wavelength_nm, fwhm_nm)| {
-                    if is_exact_band(fwhm_nm, wavelength_nm) {
-                        model.at(wavelength_nm, want, output)
-                    } else {
-                        let band = [narrow_band(wavelength_nm, fwhm_nm)];
-                        model.band(&band, want, output, &mut incoherent)
-                    }
-                })
-                .collect()
-        }
+    /// The plate's model for this incidence (the one decision of [`crate::spectral::route::model`]).
+    fn model(&self, frame: PlaneFrame, beta: C64) -> PlateModel<'_> {
+        PlateModel::new(self, frame, beta)
     }
 }
 
@@ -294,7 +113,7 @@ pub struct ExactPlate<T: Real = f64> {
     pub want: Want,
     /// Only `M00`.
     pub output: Output,
-    /// The exit medium absorbs whatever enters it ([`PlateQuery::absorbing_exit`]).
+    /// The exit medium absorbs whatever enters it ([`ThinQuery::absorbing_exit`]).
     pub absorbing_exit: bool,
 }
 
@@ -302,7 +121,7 @@ impl ExactPlate {
     /// The exact plate of a validated query.
     pub fn of(q: &PlateQuery) -> Self {
         ExactPlate {
-            plate: q.plate,
+            plate: q.element,
             want: q.want,
             output: q.output,
             absorbing_exit: q.absorbing_exit,

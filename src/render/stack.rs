@@ -1,9 +1,8 @@
 //! The lobes of a stack of layers (reflection and transmission) as a path tracer samples them,
 //! over one wavelength, a band or a set of colour channels: [`crate::render::thin`] with the
-//! stack's models of [`crate::stack::spectral`]; at exact wavelengths over any [`Real`]
+//! stack's model of [`crate::stack::spectral`]; at exact wavelengths over any [`Real`]
 //! ([`ExactStack`]), the form a program records ([`crate::record`]).
 
-use crate::band::{is_exact_band, narrow_band};
 use crate::error::Result;
 use crate::optics::frame::PlaneFrame;
 use crate::optics::medium::Uniaxial;
@@ -12,10 +11,9 @@ use crate::plate::slab::{Output, SlabMueller, Want};
 use crate::real::complex::Cx;
 use crate::real::{Real, Select};
 use crate::render::choice::Sampled;
-use crate::render::plate::{sample_exact, ExactPlate, Spectrum};
-use crate::render::thin::{self, Thin};
+use crate::render::plate::{sample_exact, ExactPlate};
+use crate::render::thin::{self, Element, Spectrum, Thin, ThinQuery};
 use crate::render::{PathLobe, Transport};
-use crate::spectral::model::Accuracy;
 use crate::stack::exact::StackBlocks;
 use crate::stack::spectral::StackModel;
 use crate::stack::{in_layer, Stack};
@@ -23,42 +21,12 @@ use nalgebra::Vector3;
 use num_complex::Complex64 as C64;
 
 /// A stack query: everything but the direction and the spectrum.
-#[derive(Clone, Debug, PartialEq)]
-pub struct StackQuery {
-    /// The stack (its exterior above, `z > 0`).
-    pub stack: Stack,
-    /// Which lobes to compute.
-    pub want: Want,
-    /// Only `M00`.
-    pub output: Output,
-    /// The exit medium absorbs whatever enters it: no transmission lobe, no light from below.
-    pub absorbing_exit: bool,
-}
+pub type StackQuery = ThinQuery<Stack>;
 
 impl StackQuery {
     /// A query of `stack` (validated by [`Stack::new`]).
     pub fn new(stack: Stack, reflection: bool, transmission: bool, intensity_only: bool) -> Self {
-        StackQuery {
-            stack,
-            want: Want {
-                reflection,
-                transmission,
-            },
-            output: if intensity_only {
-                Output::Intensity
-            } else {
-                Output::Mueller
-            },
-            absorbing_exit: false,
-        }
-    }
-
-    /// The same query with an absorbing exit medium or not.
-    pub fn with_absorbing_exit(self, absorbing_exit: bool) -> Self {
-        StackQuery {
-            absorbing_exit,
-            ..self
-        }
+        ThinQuery::of(stack, reflection, transmission, intensity_only)
     }
 }
 
@@ -83,86 +51,23 @@ pub fn stack_lobes_full(
     thin::lobes(q, spectrum, wi, transport, false)
 }
 
-impl StackQuery {
-    /// The stack seen from below: exterior and exit swapped, mirrored through `z = 0`.
-    fn flipped(&self) -> Self {
-        StackQuery {
-            stack: self.stack.flipped(),
-            ..self.clone()
-        }
-    }
-}
-
-impl Thin for StackQuery {
-    type Spectrum = Spectrum;
-
-    fn channels(spectrum: &Spectrum) -> Result<usize> {
-        let channels = spectrum.channels()?;
-        spectrum.validate()?;
-        Ok(channels)
-    }
-
-    fn is_signed(spectrum: &Spectrum) -> bool {
-        spectrum.is_signed()
-    }
-
-    fn oriented(&self, below: bool) -> Self {
-        if below {
-            self.flipped()
-        } else {
-            self.clone()
-        }
-    }
-
-    fn want(&self) -> Want {
-        self.want
-    }
-
-    fn output(&self) -> Output {
-        self.output
-    }
-
-    fn absorbing_exit(&self) -> bool {
-        self.absorbing_exit
-    }
+impl Element for Stack {
+    type Model<'a> = StackModel<'a>;
 
     fn ext(&self) -> f64 {
-        self.stack.ext.re
+        self.ext.re
     }
 
     fn exit(&self) -> f64 {
-        self.stack.exit.re
+        self.exit.re
     }
 
-    fn evaluate(
-        &self,
-        spectrum: &Spectrum,
-        frame: PlaneFrame,
-        beta: C64,
-        want: Want,
-    ) -> Result<Vec<SlabMueller>> {
-        let model = StackModel::new(&self.stack, frame, beta);
-        match *spectrum {
-            Spectrum::Weights(set) => Ok(model
-                .channels(set, want, self.output, Accuracy::Perceptual)?
-                .to_vec()),
-            _ => spectrum
-                .bands()
-                .into_iter()
-                .map(|(wavelength_nm, fwhm_nm)| {
-                    if is_exact_band(fwhm_nm, wavelength_nm) {
-                        model.at(wavelength_nm, want, self.output)
-                    } else {
-                        model.band(
-                            &narrow_band(wavelength_nm, fwhm_nm),
-                            want,
-                            self.output,
-                            Accuracy::Perceptual,
-                        )
-                    }
-                })
-                .collect(),
-        }
+    fn flipped(&self) -> Self {
+        Stack::flipped(self)
+    }
+
+    fn model(&self, frame: PlaneFrame, beta: C64) -> StackModel<'_> {
+        StackModel::new(self, frame, beta)
     }
 }
 
@@ -185,7 +90,7 @@ pub struct ExactStack<T: Real = f64> {
     pub want: Want,
     /// Only `M00`.
     pub output: Output,
-    /// The exit medium absorbs whatever enters it ([`StackQuery::absorbing_exit`]).
+    /// The exit medium absorbs whatever enters it ([`ThinQuery::absorbing_exit`]).
     pub absorbing_exit: bool,
 }
 
@@ -193,7 +98,7 @@ impl ExactStack {
     /// The exact stack of a query (validated by [`Stack::new`]).
     pub fn of(q: &StackQuery) -> Self {
         ExactStack {
-            stack: q.stack.clone(),
+            stack: q.element.clone(),
             below: false,
             want: q.want,
             output: q.output,

@@ -7,17 +7,250 @@
 //! lobe's own incidence; in Radiance mode (light from the mirror direction, or from the far
 //! side) each lobe is the reversed path of the forward one ([`reversed`], the reciprocity of
 //! media with symmetric dielectric tensors). Light from below sees the element flipped
-//! ([`Thin::flipped`]: exterior and exit swapped, mirrored through `z = 0`), solved as if from
+//! ([`Thin::oriented`], [`Element::flipped`]: exterior and exit swapped, mirrored through `z = 0`), solved as if from
 //! above, its matrices mirrored back (`D M D`, `D = diag(1, 1, −1, −1)`).
 
+
+use crate::band::{is_exact_band, narrow_band};
+use crate::colour::weights::WeightSet;
 use crate::error::{Error, Result};
+use crate::material::check_wavelength;
 use crate::optics::frame::PlaneFrame;
 use crate::optics::mueller::reversed;
+use crate::params::Bandwidth;
 use crate::plate::slab::{Output, SlabMueller, Want};
+use crate::quadrature::Accuracy;
 use crate::real::complex::{self as cx, Cx};
 use crate::real::{Mask, Real};
 use crate::render::{PathLobe, Transport};
+use crate::spectral::model::ThinModel;
 use nalgebra::{Matrix4, Vector3};
+use num_complex::Complex64 as C64;
+
+/// Over which spectrum a thin element (a plate, a stack) is evaluated.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Spectrum {
+    /// One wavelength: exact if `fwhm_nm == 0`, else a Gaussian band of that FWHM (closed form).
+    Band {
+        /// Centre wavelength (nm).
+        wavelength_nm: f64,
+        /// Full width at half maximum (nm).
+        fwhm_nm: f64,
+    },
+    /// Every channel of a weight set (closed form).
+    Weights(WeightSet),
+    /// The first `count` (at most [`MAX_BANDS`]) wavelengths of `wavelengths_nm`, each as
+    /// [`Spectrum::Band`] with the same `fwhm_nm`: the wavelengths a spectral renderer traces
+    /// along one path, answered in one query (a plate's wavelength-independent work is shared).
+    Bands {
+        /// Centre wavelengths (nm).
+        wavelengths_nm: [f64; MAX_BANDS],
+        /// How many of them are used.
+        count: usize,
+        /// Full width at half maximum (nm).
+        fwhm_nm: f64,
+    },
+}
+
+/// Most wavelengths of one [`Spectrum::Bands`] query (Mitsuba's spectral variants trace 4).
+pub const MAX_BANDS: usize = 4;
+
+impl Spectrum {
+    /// True if a channel's weight can be negative (linear sRGB: out-of-gamut colours give a
+    /// negative channel value, which is the colour, not an error).
+    pub(crate) fn is_signed(&self) -> bool {
+        matches!(self, Spectrum::Weights(set) if set.is_signed())
+    }
+
+    /// Channels of the answer.
+    pub(crate) fn channels(&self) -> Result<usize> {
+        match *self {
+            Spectrum::Band { .. } => Ok(1),
+            Spectrum::Weights(_) => Ok(3),
+            Spectrum::Bands { count, .. } if (1..=MAX_BANDS).contains(&count) => Ok(count),
+            Spectrum::Bands { count, .. } => Err(Error::new(
+                "count",
+                format!("must be 1 to {MAX_BANDS} wavelengths, got {count}"),
+            )),
+        }
+    }
+
+    /// Checks every band's wavelength and `filter_bandwidth` ([`Bandwidth`]), once per query.
+    pub(crate) fn validate(&self) -> Result<()> {
+        for (wavelength_nm, fwhm_nm) in self.bands() {
+            check_wavelength(wavelength_nm)?;
+            Bandwidth::new("filter_bandwidth", fwhm_nm, wavelength_nm)?;
+        }
+        Ok(())
+    }
+
+    /// The single bands `(wavelength_nm, fwhm_nm)` of a [`Spectrum::Band`] or
+    /// [`Spectrum::Bands`] (empty for weights).
+    pub(crate) fn bands(&self) -> Vec<(f64, f64)> {
+        match *self {
+            Spectrum::Band {
+                wavelength_nm,
+                fwhm_nm,
+            } => vec![(wavelength_nm, fwhm_nm)],
+            Spectrum::Bands {
+                wavelengths_nm,
+                count,
+                fwhm_nm,
+            } => wavelengths_nm[..count.min(MAX_BANDS)]
+                .iter()
+                .map(|&l| (l, fwhm_nm))
+                .collect(),
+            Spectrum::Weights(_) => Vec::new(),
+        }
+    }
+}
+
+/// A thin element on the host (a plate, a stack): its two media, the element seen from below,
+/// and its model at one incidence ([`ThinModel`]). Its query ([`ThinQuery`]) is a [`Thin`].
+pub trait Element: Clone {
+    /// The element at one incidence.
+    type Model<'a>: ThinModel
+    where
+        Self: 'a;
+    /// Real index of the exterior (above, `z > 0`).
+    fn ext(&self) -> f64;
+    /// Real index of the exit medium (below).
+    fn exit(&self) -> f64;
+    /// The element seen from below: exterior and exit swapped, mirrored through `z = 0`.
+    fn flipped(&self) -> Self;
+    /// The element for light from above with incidence parameter `beta` in the plane of
+    /// `frame`.
+    fn model(&self, frame: PlaneFrame, beta: C64) -> Self::Model<'_>;
+}
+
+/// A query of a thin element: everything but the direction and the spectrum.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ThinQuery<E> {
+    /// The element (its exterior above, `z > 0`).
+    pub element: E,
+    /// Which lobes to compute.
+    pub want: Want,
+    /// Only `M00`.
+    pub output: Output,
+    /// The exit medium absorbs whatever enters it (a film on a black substrate): no
+    /// transmission lobe, and no light from below (it cannot reach the element).
+    pub absorbing_exit: bool,
+}
+
+impl<E> ThinQuery<E> {
+    /// A query of `element` for the lobes asked for, full Mueller matrices or only `M00`.
+    pub fn of(element: E, reflection: bool, transmission: bool, intensity_only: bool) -> Self {
+        ThinQuery {
+            element,
+            want: Want {
+                reflection,
+                transmission,
+            },
+            output: if intensity_only {
+                Output::Intensity
+            } else {
+                Output::Mueller
+            },
+            absorbing_exit: false,
+        }
+    }
+
+    /// The same query with an absorbing exit medium or not ([`ThinQuery::absorbing_exit`]).
+    pub fn with_absorbing_exit(self, absorbing_exit: bool) -> Self {
+        ThinQuery {
+            absorbing_exit,
+            ..self
+        }
+    }
+}
+
+/// The element's Mueller matrices (s/p frames) over `spectrum`, per channel, through `model`:
+/// the channels of a weight set at the perceptual budget, each band exact (zero width) or over
+/// its Gaussian.
+pub fn evaluate<M: ThinModel>(
+    model: &M,
+    spectrum: &Spectrum,
+    want: Want,
+    output: Output,
+) -> Result<Vec<SlabMueller>> {
+    match *spectrum {
+        Spectrum::Weights(set) => Ok(model
+            .channels(set, want, output, Accuracy::Perceptual)?
+            .to_vec()),
+        _ => spectrum
+            .bands()
+            .into_iter()
+            .map(|(wavelength_nm, fwhm_nm)| {
+                if is_exact_band(fwhm_nm, wavelength_nm) {
+                    model.at(wavelength_nm, want, output)
+                } else {
+                    let band = [narrow_band(wavelength_nm, fwhm_nm)];
+                    model.band(&band, want, output, Accuracy::Perceptual)
+                }
+            })
+            .collect(),
+    }
+}
+
+/// The element's lobes seen from `wi`, one `[reflection, transmission]` pair per spectral
+/// channel (module docs). `share`: one solve for both lobes (else each lobe solved on its own,
+
+/// A host query is the thin element over `f64`: its spectrum a [`Spectrum`], evaluated through
+/// the element's model ([`evaluate`]).
+impl<E: Element> Thin for ThinQuery<E> {
+    type Spectrum = Spectrum;
+
+    fn want(&self) -> Want {
+        self.want
+    }
+
+    fn output(&self) -> Output {
+        self.output
+    }
+
+    fn absorbing_exit(&self) -> bool {
+        self.absorbing_exit
+    }
+
+    fn ext(&self) -> f64 {
+        self.element.ext()
+    }
+
+    fn exit(&self) -> f64 {
+        self.element.exit()
+    }
+
+    fn oriented(&self, below: bool) -> Self {
+        if below {
+            ThinQuery {
+                element: self.element.flipped(),
+                ..self.clone()
+            }
+        } else {
+            self.clone()
+        }
+    }
+
+    fn channels(spectrum: &Spectrum) -> Result<usize> {
+        let channels = spectrum.channels()?;
+        spectrum.validate()?;
+        Ok(channels)
+    }
+
+    fn is_signed(spectrum: &Spectrum) -> bool {
+        spectrum.is_signed()
+    }
+
+    fn evaluate(
+        &self,
+        spectrum: &Spectrum,
+        frame: PlaneFrame,
+        beta: C64,
+        want: Want,
+    ) -> Result<Vec<SlabMueller>> {
+        evaluate(&self.element.model(frame, beta), spectrum, want, self.output)
+    }
+}
 
 /// A thin element as the lobes need it, over the reals `T` (`f64` on the host).
 pub trait Thin<T: Real = f64>: Sized {

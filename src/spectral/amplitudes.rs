@@ -1,5 +1,5 @@
 //! A plate's interface blocks across the visible band: solved exactly at the Chebyshev–Lobatto
-//! nodes of one level ([`crate::spectral::nodes`]) and interpolated between them.
+//! nodes of one level ([`crate::quadrature::nodes`]) and interpolated between them.
 //!
 //! The level follows the blocks' own Chebyshev coefficients. For a function analytic around
 //! the band they decay geometrically, `|c_m| ≈ C r^m`, and the interpolant on `n` nodes errs by
@@ -16,9 +16,9 @@ use crate::optics::frame::PlaneFrame;
 use crate::optics::modes::ModeKind;
 use crate::plate::slab::{SlabBlocks, BLOCK_VALUES};
 use crate::plate::Plate;
+use crate::quadrature::fringe;
+use crate::quadrature::nodes::{self, series_tail, FINEST, LEVELS, MAX_NODES, SPAN};
 use crate::scratch::{Pool, Pooled};
-use crate::spectral::fringe;
-use crate::spectral::nodes::{self, FINEST, LEVELS, MAX_NODES, SPAN};
 use num_complex::Complex64 as C64;
 use std::f64::consts::TAU;
 
@@ -27,7 +27,7 @@ use std::f64::consts::TAU;
 /// effect: the 5-node level (whose error is 3.5e-6 to 1.3e-5 for quartz and calcite) instead of
 /// 9 nodes changes colours by a mean CIEDE2000 of 0.0004-0.0008 and at most 0.014-0.027 (on
 /// the validation plates of `tests/spectral_rgb.rs`), far inside the budget of
-/// [`crate::spectral::budget`].
+/// [`crate::quadrature::budget`].
 pub const AMPLITUDE_TOLERANCE: f64 = 3e-5;
 
 /// The level a dispersive plate starts on (5 nodes: the blocks of every named crystal but
@@ -213,30 +213,6 @@ fn take_nodes() -> Pooled<Nodes> {
     });
     n.blocks.iter_mut().for_each(|b| *b = None);
     n
-}
-
-/// `2 Σ_{m≥n} |c_m|` beyond the `n` known coefficient magnitudes `c`, for a geometric decay
-/// estimated from the last four in pairs (the even and odd parts of a function can decay
-/// differently): with `s = |c_{n−1}| + |c_{n−2}|`, `r = √(s / (|c_{n−3}| + |c_{n−4}|))` per
-/// coefficient (at most 0.9), `2 s r/(1 − r)`.
-fn series_tail(c: &[f64]) -> f64 {
-    let n = c.len();
-    if n < 4 {
-        return 0.0;
-    }
-    // The last two coefficients (even and odd parts can decay at different rates) and the
-    // ratio of the last pair to the pair before.
-    let (last, before) = (c[n - 1] + c[n - 2], c[n - 3] + c[n - 4]);
-    if last == 0.0 {
-        return 0.0;
-    }
-    let r = if before > 0.0 {
-        (last / before).sqrt()
-    } else {
-        1.0
-    }
-    .min(0.9);
-    2.0 * last * r / (1.0 - r)
 }
 
 /// The least attenuation exponent per traversal over the band, `d min_k k Im Q_m(k)` (zero for

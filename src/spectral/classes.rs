@@ -7,7 +7,7 @@
 //! ([`crate::plate::paths`]); the coherency's pairs of classes are grouped by what their
 //! spectral factor depends on ([`crate::spectral::layout`]). A group oscillates as
 //! `e^{iφ_Δ(k)}` around its group path `G_Δ = φ_Δ'(k₀)` and integrates against every channel
-//! by the fringe rules of [`crate::spectral::fringe`]:
+//! by the fringe rules of [`crate::quadrature::fringe`]:
 //!
 //! ```text
 //! ∫ w_c(k) K_Δ(k) dk = e^{iφ_Δ(k₀)} Σ_p P_Δ(k_p) W_pc(G_Δ),
@@ -21,28 +21,28 @@
 //! dispersion in thick plates) takes a shared product-integration rule of as many points as its
 //! chirp needs ([`Integration::dense`]). Groups whose fringe is invisible in every channel are dropped; orders
 //! beyond the coherent ones are the incoherent tail of [`crate::plate::paths`]. The budget of
-//! every approximation: [`crate::spectral::budget`].
+//! every approximation: [`crate::quadrature::budget`].
 
+use crate::colour::weights::WeightSet;
 use crate::error::Result;
 use crate::optics::mueller;
 use crate::plate::paths::{ClassAmplitudes, Lobe};
 use crate::plate::slab::{Output, SlabMueller, Want};
+use crate::quadrature::budget::{DROP, NODE_ERROR, ORDER_TAIL};
+use crate::quadrature::chebyshev;
+use crate::quadrature::fringe;
+use crate::quadrature::nodes::{self, LEVELS, MAX_NODES};
 use crate::scratch::{Pool, Pooled};
 use crate::spectral::amplitudes::traversal_q;
-use crate::spectral::budget::{DROP, NODE_ERROR, ORDER_TAIL};
-use crate::spectral::fringe;
 use crate::spectral::layout::{self, Group, Layout, MAX_ORDER};
-use crate::spectral::nodes::{self, LEVELS, MAX_NODES};
-use crate::spectral::shared;
 use crate::spectral::survey::Survey;
-use crate::spectral::weights::WeightSet;
 use nalgebra::{Matrix2, Matrix4};
 use num_complex::Complex64 as C64;
 use std::f64::consts::TAU;
 
 /// How the path-class method integrates a plate.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Plan {
+pub struct Orders {
     /// Highest coherent order (the rest is the incoherent tail).
     pub order: usize,
     /// Pairs of different orders can be visible (a round trip within the coherence of the
@@ -61,7 +61,7 @@ const PHASE_LEVEL: usize = 4;
 /// `ρ^{2n}`), at most [`MAX_ORDER`] (beyond, the tail takes the rest: plates near grazing
 /// incidence, where the round trip reflects nearly everything; docs/physics.md §4, "Known
 /// limitations", gives that error as measured). `None` if the orders do not converge (`ρ ≥ 1`).
-pub fn plan(s: &Survey, set: WeightSet) -> Option<Plan> {
+pub fn plan(s: &Survey, set: WeightSet) -> Option<Orders> {
     let rho = s.rho;
     // `ρ ≥ 1` or NaN: the orders do not converge.
     if rho.is_nan() || rho >= 1.0 {
@@ -80,7 +80,8 @@ pub fn plan(s: &Survey, set: WeightSet) -> Option<Plan> {
             g[0].min(g[1]) + g[2].min(g[3]) - 2.0 * split
         })
         .0;
-    let sum = 1.0 / (1.0 - rho);
+    // The n-th round trip weighs at most C ρⁿ (the survey's transient).
+    let sum = s.transient / (1.0 - rho);
     let order = (0..=MAX_ORDER)
         .find(|&n| {
             let next = (n + 1) as f64;
@@ -90,10 +91,11 @@ pub fn plan(s: &Survey, set: WeightSet) -> Option<Plan> {
         })
         .unwrap_or(MAX_ORDER);
     let cross_orders = 2.0 * rho * sum * rule.visibility_beyond(nearest.max(0.0)) >= DROP;
-    Some(Plan {
+    Some(Orders {
         order,
         cross_orders,
-        tail_strength: rho.powi(2 * (order as i32 + 1)) / (1.0 - rho * rho),
+        tail_strength: s.transient * s.transient * rho.powi(2 * (order as i32 + 1))
+            / (1.0 - rho * rho),
     })
 }
 
@@ -126,6 +128,12 @@ struct Work {
     series: Option<TraversalSeries>,
     /// The traversals' phases on the shared rules the chirped groups use (one per rung).
     chirped: Vec<TraversalPhases>,
+    /// Per class `a` of a lobe summed by [`Sums::Classes`]: `B_ac` per channel at the current
+    /// node, and the node it was last cleared at (`u32::MAX`: never).
+    class_sums: Vec<([Matrix2<C64>; 3], u32)>,
+    /// The slots of [`Work::class_sums`] with a `B_ac` at the current node (reflected
+    /// classes first, then transmitted ones).
+    touched: Vec<u32>,
 }
 
 /// Nodes of [`PHASE_LEVEL`].
@@ -181,7 +189,7 @@ struct TraversalPhases {
 }
 
 impl TraversalPhases {
-    fn fill(&mut self, s: &Survey, rule: &shared::Rule, series: &TraversalSeries) {
+    fn fill(&mut self, s: &Survey, rule: &chebyshev::Rule, series: &TraversalSeries) {
         let (k0, a) = fringe::band();
         let d = s.plate.thickness_nm;
         let at = |c: &[[f64; PHASE_NODES]; 4], k: f64| -> [f64; 4] {
@@ -213,6 +221,8 @@ fn work() -> Pooled<Work> {
             q: [None; MAX_NODES],
             series: None,
             chirped: Vec::new(),
+            class_sums: Vec::new(),
+            touched: Vec::new(),
         })
     });
     w.placed.clear();
@@ -223,13 +233,43 @@ fn work() -> Pooled<Work> {
     w
 }
 
+/// How the pairs of a lobe's groups are summed into its coherency at an amplitude node
+/// `i`, `K_ic = Σ_g ω_gic Σ_(a,b)∈g w_ab cross(A_a, A_b)` (`w` = 1 for a class with itself, 2
+/// otherwise); both orders of summation give the same value to rounding.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Sums {
+    /// Per group its pair sum `S_g = Σ w cross(A_a, A_b)` (16 complex products a pair), then
+    /// `ω_gic S_g` per channel (48 a group).
+    Pairs,
+    /// Pair-free: per class `a`, `B_ac = Σ_(a,b) w ω_gic A_b` over its pairs (12 a pair), then
+    /// one `cross(A_a, B_ac)` per channel (48 a class).
+    Classes,
+    /// Per lobe, the one of the two with fewer products for its kept groups (`16 P + 48 G`
+    /// against `12 P + 48 C` for `P` pairs in `G` groups of `C` first classes): the classes'
+    /// sums where a lobe's pairs spread over many groups (thin plates, many visible fringes),
+    /// the groups' where a few groups hold many pairs (thick plates: the diagonal groups).
+    Cheaper,
+}
+
 /// `∫ w_c M` for the channels of `set` by `plan` (module docs).
-pub fn integrate(
+pub fn channels(
     s: &Survey,
-    plan: &Plan,
+    plan: &Orders,
     set: WeightSet,
     want: Want,
     output: Output,
+) -> Result<[SlabMueller; 3]> {
+    channels_summed(s, plan, set, want, output, Sums::Cheaper)
+}
+
+/// [`channels`] with the pairs summed by `sums`.
+pub fn channels_summed(
+    s: &Survey,
+    plan: &Orders,
+    set: WeightSet,
+    want: Want,
+    output: Output,
+    sums: Sums,
 ) -> Result<[SlabMueller; 3]> {
     let mut w = work();
     let w = &mut *w;
@@ -238,8 +278,8 @@ pub fn integrate(
         .iter()
         .any(|q| q.im != 0.0);
     let loss = s.loss.unwrap_or([0.0; 4]);
-    let layouts =
-        [Lobe::Reflection, Lobe::Transmission].map(|l| layout::layout(l, plan.order, absorbing));
+    let layouts = [Lobe::Reflection, Lobe::Transmission]
+        .map(|l| layout::layout(l, plan.order, absorbing, plan.cross_orders));
     // The classes at the centre decide which groups are kept.
     w.classes.expand(s.amplitudes.centre(), plan.order, want);
     for (l, layout) in layouts.iter().enumerate() {
@@ -258,6 +298,17 @@ pub fn integrate(
         }
     }
     phases(s, w)?;
+    let by_classes = [0, 1].map(|l| match sums {
+        Sums::Pairs => false,
+        Sums::Classes => true,
+        Sums::Cheaper => classes_cheaper(layouts[l], w.placed.iter().filter(|p| p.lobe == l)),
+    });
+    // Every slot cleared at its first use in a node (`u32::MAX`: at none yet).
+    w.class_sums.clear();
+    w.class_sums.resize(
+        layouts[0].counts.len() + layouts[1].counts.len(),
+        ([Matrix2::zeros(); 3], u32::MAX),
+    );
     let it = Integration { s, set };
     for p in 0..w.placed.len() {
         let start = w.omega.len();
@@ -308,10 +359,43 @@ pub fn integrate(
                 continue;
             };
             let layout = layouts[p.lobe];
-            let m = pair_sum(layout, &layout.groups[p.group], &w.classes, p.lobe, output);
             let shares = &w.omega[p.omega + node];
+            let group = &layout.groups[p.group];
+            if by_classes[p.lobe] {
+                let amps = lobe_amplitudes(&w.classes, p.lobe);
+                let offset = p.lobe * layouts[0].counts.len();
+                for &(a, b) in &layout.pairs[group.pairs.clone()] {
+                    let slot = offset + a as usize;
+                    let (sum, stamp) = &mut w.class_sums[slot];
+                    if *stamp != i as u32 {
+                        *stamp = i as u32;
+                        *sum = [Matrix2::zeros(); 3];
+                        w.touched.push(slot as u32);
+                    }
+                    let weight = if a == b { 1.0 } else { 2.0 };
+                    for (b_c, share) in sum.iter_mut().zip(shares) {
+                        *b_c += amps[b as usize] * (share * weight);
+                    }
+                }
+                continue;
+            }
+            let m = pair_sum(layout, group, &w.classes, p.lobe, output);
             for (acc_c, share) in acc.iter_mut().zip(shares) {
                 add_scaled(&mut acc_c[p.lobe], &m, *share, output);
+            }
+        }
+        // The classes' sums of both lobes (a lobe's classes in its own range of `class_sums`).
+        let reflected = layouts[0].counts.len();
+        for slot in w.touched.drain(..) {
+            let slot = slot as usize;
+            let (l, a) = if slot < reflected {
+                (0, slot)
+            } else {
+                (1, slot - reflected)
+            };
+            let x = &lobe_amplitudes(&w.classes, l)[a];
+            for (acc_c, b_c) in acc.iter_mut().zip(&w.class_sums[slot].0) {
+                cross_add(&mut acc_c[l], x, b_c, 1.0, output == Output::Intensity);
             }
         }
         if let Some(node) = index[tail_level] {
@@ -363,7 +447,7 @@ pub fn integrate(
 #[allow(clippy::too_many_arguments)]
 fn select(
     s: &Survey,
-    plan: &Plan,
+    plan: &Orders,
     set: WeightSet,
     l: usize,
     layout: &Layout,
@@ -576,7 +660,7 @@ impl Integration<'_, '_> {
 
     /// A group whose residual phase no level resolves (the chirp of a thick, strongly
     /// dispersive plate), on a shared product-integration rule of the weights
-    /// ([`crate::spectral::shared`]): `ω_ic = Σ_j W_jc e^{iφ(k_j) − α(k_j)} L_i(k_j)` with its
+    /// ([`crate::quadrature::chebyshev`]): `ω_ic = Σ_j W_jc e^{iφ(k_j) − α(k_j)} L_i(k_j)` with its
     /// phase `φ(k) = k d Δ·Re Q(k)` and attenuation `α(k) = k d Σ·Im Q(k)` from their Chebyshev
     /// interpolants through the exact values at the nodes of [`PHASE_LEVEL`] (`Q` is analytic
     /// around the band: they converge geometrically) and its amplitude interpolated between its
@@ -607,14 +691,11 @@ impl Integration<'_, '_> {
             })
             .fold(0.0, f64::max);
         let tolerance = NODE_ERROR / p.strength.max(1e-300);
-        let points = shared::LADDER
-            .iter()
-            .copied()
-            .find(|&n| {
-                shared::rule(self.set, n).error_at(shared::SPAN_MARGIN * fastest) <= tolerance
-            })
-            .unwrap_or(shared::LADDER[shared::LADDER.len() - 1]);
-        let rule = shared::rule(self.set, points);
+        let points = chebyshev::smallest_rung(self.set, |error| {
+            error(chebyshev::SPAN_MARGIN * fastest) <= tolerance
+        })
+        .unwrap_or(chebyshev::LADDER[chebyshev::LADDER.len() - 1]);
+        let rule = chebyshev::rule(self.set, points);
         let i = match chirped.iter().position(|t| t.points == rule.nodes.len()) {
             Some(i) => i,
             None => {
@@ -631,20 +712,50 @@ impl Integration<'_, '_> {
             chirped[i].fill(self.s, rule, series);
         }
         let table = &chirped[i];
-        let bases = shared::node_basis(self.set, points, p.amplitude_level);
+        let bases = chebyshev::node_basis(self.set, points, p.amplitude_level);
         let n = LEVELS[p.amplitude_level];
-        let rows = rule.nodes.iter().zip(bases);
+        let rows = rule.nodes.iter().zip(bases.chunks_exact(n));
         for (((_, w), basis), (phi, alpha)) in rows.zip(table.phase.iter().zip(&table.attenuation))
         {
             let factor = C64::from_polar((-dot(&sum, alpha)).exp(), dot(&delta, phi));
             let fw = [factor * w[0], factor * w[1], factor * w[2]];
-            for (o, l) in out.iter_mut().zip(&basis[..n]) {
+            for (o, l) in out.iter_mut().zip(basis) {
                 for c in 0..3 {
                     o[c] += fw[c] * *l;
                 }
             }
         }
     }
+}
+
+/// The amplitudes of lobe `l`'s classes (0: reflection, 1: transmission).
+fn lobe_amplitudes(classes: &ClassAmplitudes, l: usize) -> &[Matrix2<C64>] {
+    if l == 0 {
+        &classes.reflection
+    } else {
+        &classes.transmission
+    }
+}
+
+/// True if [`Sums::Classes`] takes fewer complex products than [`Sums::Pairs`] for a lobe's
+/// kept groups `placed` (the costs of [`Sums`]).
+fn classes_cheaper<'a>(layout: &Layout, placed: impl Iterator<Item = &'a Placed>) -> bool {
+    let (mut pairs, mut groups) = (0usize, 0usize);
+    // A lobe has at most 385 classes (reflection at `MAX_ORDER`); a class beyond would only
+    // be miscounted, never summed wrongly.
+    let mut first = [false; 512];
+    let mut classes = 0usize;
+    for p in placed {
+        let range = layout.groups[p.group].pairs.clone();
+        pairs += range.len();
+        groups += 1;
+        for &(a, _) in &layout.pairs[range] {
+            let seen = &mut first[(a as usize).min(first.len() - 1)];
+            classes += usize::from(!*seen);
+            *seen = true;
+        }
+    }
+    12 * pairs + 48 * classes < 16 * pairs + 48 * groups
 }
 
 /// `Σ_pairs w cross(A_a, A_b)` of a group at one node (`w` = 1 for a class with itself, 2
@@ -656,11 +767,7 @@ fn pair_sum(
     lobe: usize,
     output: Output,
 ) -> Matrix4<C64> {
-    let amps: &[Matrix2<C64>] = if lobe == 0 {
-        &classes.reflection
-    } else {
-        &classes.transmission
-    };
+    let amps = lobe_amplitudes(classes, lobe);
     let mut m = Matrix4::zeros();
     for &(a, b) in &layout.pairs[g.pairs.clone()] {
         let w = if a == b { 1.0 } else { 2.0 };

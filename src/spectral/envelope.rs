@@ -1,7 +1,7 @@
 //! The plate over the channels of a weight set with every internal order in closed form: the
 //! exact plate's coherency sampled at the Chebyshev–Lobatto nodes of the band, whole or split
 //! into families of pairs of orders a fixed number of round trips apart, each family's fast
-//! common oscillation integrated exactly by the fringe rules of [`crate::spectral::fringe`].
+//! common oscillation integrated exactly by the fringe rules of [`crate::quadrature::fringe`].
 //!
 //! **Families of orders.** With the internal round trip `D = r₃ P↑ r₂ P↓` and a reference phase
 //! `φ(k) = G (k − k₀)` per round trip (`G` the round trip's middle group path), write
@@ -18,11 +18,11 @@
 //! `conj(r₁) ⊗ Ṽ D̃^{Δ−1} t₁`. `F_Δ` keeps only what differs from the reference within a
 //! family (the o/e split, dispersion, absorption): slow where this method is chosen, so each
 //! family integrates as `∫ w_c e^{iΔφ} F_Δ = Σ_i W_ic(ΔG) F_Δ(k_i)` on the nodes `k_i`
-//! ([`crate::spectral::fringe`]). By Cayley–Hamilton `D̃^Δ = α_Δ I + β_Δ D̃`, so every family at a
+//! ([`crate::quadrature::fringe`]). By Cayley–Hamilton `D̃^Δ = α_Δ I + β_Δ D̃`, so every family at a
 //! node comes from two solves with one factorisation, `Y₀ = (I − D̄̃ ⊗ D̃)⁻¹ (t̄₁ ⊗ t₁)` and
 //! `Y₁` with `D̃ t₁`: per channel `Σ_Δ W_ic(ΔG) F_Δ(k_i) = (X̄ ⊗ X)(α Y₀ + β Y₁)` with
 //! `α = Σ_Δ W_ic(ΔG) α_Δ` (and `β` likewise). Families beyond the last visible one
-//! ([`crate::spectral::fringe::FringeRule::visibility_beyond`]) are dropped; the rest is exact
+//! ([`crate::quadrature::fringe::FringeRule::visibility_beyond`]) are dropped; the rest is exact
 //! up to the interpolation of each family's slow factor on the nodes.
 //!
 //! **The whole plate.** Where the plate's spectrum is slow altogether (thin plates, a plate of
@@ -33,18 +33,18 @@
 //! `δ` in group path and `x` in attenuation across the half band `a` has a slow factor varying
 //! as `e^{i n (δ a + x) t}`; its weight is at most `ρ^s` (`s` the pair's round trips, `ρ` the
 //! survey's bound on a round trip's norm). The level is the coarsest whose
-//! [`crate::spectral::budget::interpolation_error`], summed over the pairs with these weights,
-//! meets [`crate::spectral::budget::NODE_ERROR`].
+//! [`crate::quadrature::budget::interpolation_error`], summed over the pairs with these weights,
+//! meets [`crate::quadrature::budget::NODE_ERROR`].
 
 use crate::cmath;
+use crate::colour::weights::WeightSet;
 use crate::error::{Error, Result};
 use crate::optics::mueller;
 use crate::plate::slab::{Output, SlabBlocks, SlabMueller, Want};
-use crate::spectral::budget::{DROP, NODE_ERROR};
-use crate::spectral::fringe;
-use crate::spectral::nodes::{self, LEVELS};
+use crate::quadrature::budget::{DROP, NODE_ERROR};
+use crate::quadrature::fringe;
+use crate::quadrature::nodes::{self, LEVELS};
 use crate::spectral::survey::Survey;
-use crate::spectral::weights::WeightSet;
 use nalgebra::{Matrix2, Matrix4};
 use num_complex::Complex64 as C64;
 use std::f64::consts::TAU;
@@ -55,7 +55,7 @@ pub const MAX_FAMILIES: usize = 48;
 
 /// How the envelope method integrates a plate.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Plan {
+pub struct Envelope {
     /// The level of the nodes (index into [`LEVELS`]).
     pub level: usize,
     /// The families of orders split off; `None`: the whole plate at the nodes.
@@ -82,6 +82,8 @@ struct Rates {
     split: [f64; 2],
     tilt: f64,
     rho: f64,
+    /// The survey's transient `C` (the `n`-th round trip at most `C ρⁿ`).
+    transient: f64,
 }
 
 impl Rates {
@@ -107,6 +109,7 @@ impl Rates {
                 split: [0.0; 2],
                 tilt: 0.0,
                 rho: 0.0,
+                transient: 1.0,
             });
         };
         let (lo, hi) = s.group_path_range(|g| g[bd] + g[bu]);
@@ -124,6 +127,7 @@ impl Rates {
             split,
             tilt: s.attenuation_tilt(),
             rho: s.rho,
+            transient: s.transient,
         })
     }
 
@@ -144,7 +148,10 @@ impl Rates {
                 per_nm: a * e.im,
                 rho: self.rho,
             };
-            let Some(m) = bound(&growth) else { break };
+            // Each side of a pair of orders carries at most the transient C.
+            let Some(m) = bound(&growth).map(|m| m * self.transient * self.transient) else {
+                break;
+            };
             for (l, b) in best.iter_mut().enumerate().skip(first) {
                 *b = b.min(4.0 * m * e.inverse_powers[l] / (e.r - 1.0));
             }
@@ -239,14 +246,14 @@ impl Growth {
 /// The plan for `survey` over `set`: the whole plate or families of orders, whichever needs
 /// fewer node evaluations (a family split costs about three evaluations of the plate per node);
 /// `None` if neither resolves the plate on the finest level.
-pub fn plan(s: &Survey, set: WeightSet) -> Option<Plan> {
+pub fn plan(s: &Survey, set: WeightSet) -> Option<Envelope> {
     let rates = Rates::of(s)?;
     let first = s.amplitudes.level;
     // The whole plate: every family, a round trip's whole group path in each.
     let full = rates.round_trip.abs() + rates.chirp;
     let whole = rates
         .coarsest(first, |g| g.families(full, None))
-        .map(|level| Plan {
+        .map(|level| Envelope {
             level,
             families: None,
         });
@@ -256,7 +263,7 @@ pub fn plan(s: &Survey, set: WeightSet) -> Option<Plan> {
     let split = last_family(&rates, set).and_then(|last| {
         rates
             .coarsest(first, |g| g.families(rates.chirp, Some(last)))
-            .map(|level| Plan {
+            .map(|level| Envelope {
                 level,
                 families: Some(Families {
                     group_path: rates.round_trip,
@@ -264,7 +271,7 @@ pub fn plan(s: &Survey, set: WeightSet) -> Option<Plan> {
                 }),
             })
     });
-    let cost = |p: &Plan| LEVELS[p.level] as f64 * if p.families.is_some() { 3.0 } else { 1.0 };
+    let cost = |p: &Envelope| LEVELS[p.level] as f64 * if p.families.is_some() { 3.0 } else { 1.0 };
     match (whole, split) {
         (Some(w), Some(f)) => Some(if cost(&f) < cost(&w) { f } else { w }),
         (w, f) => w.or(f),
@@ -285,7 +292,7 @@ fn last_family(r: &Rates, set: WeightSet) -> Option<usize> {
     if g <= 0.0 {
         return None;
     }
-    let geometric = 1.0 / (1.0 - r.rho * r.rho);
+    let geometric = r.transient * r.transient / (1.0 - r.rho * r.rho);
     let remainder = 1e-2 * DROP * (1.0 - r.rho) / geometric;
     let strong = if r.rho > 0.0 && remainder < 1.0 {
         (remainder.ln() / (2.0 * r.rho.ln())).ceil()
@@ -318,9 +325,9 @@ fn last_family(r: &Rates, set: WeightSet) -> Option<usize> {
 }
 
 /// `∫ w_c M` for the channels of `set` by `plan` (module docs).
-pub fn integrate(
+pub fn channels(
     s: &Survey,
-    plan: &Plan,
+    plan: &Envelope,
     set: WeightSet,
     want: Want,
     output: Output,

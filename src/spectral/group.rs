@@ -11,12 +11,7 @@ use num_complex::Complex64 as C64;
 /// First and second derivatives in `k` of the phase-per-traversal `Q` of the layer's four modes
 /// `[o↓, e↓, o↑, e↑]` at wavenumber `mu` (zero without dispersion), by central differences of
 /// the exact modes (step `10⁻³ μ`: truncation ~10⁻⁶, rounding ~10⁻¹⁰ relative).
-pub(crate) fn dispersion(
-    plate: &Plate,
-    frame: &PlaneFrame,
-    beta: C64,
-    mu: f64,
-) -> Result<Dispersion> {
+pub fn dispersion(plate: &Plate, frame: &PlaneFrame, beta: C64, mu: f64) -> Result<Dispersion> {
     if !plate.is_dispersive() {
         return Ok(Dispersion::default());
     }
@@ -34,14 +29,16 @@ pub(crate) fn dispersion(
 
 /// `dQ/dk` and `d²Q/dk²` per mode (see [`dispersion`]).
 #[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct Dispersion {
-    pub(crate) d1: [f64; 4],
-    pub(crate) d2: [f64; 4],
+pub struct Dispersion {
+    /// `dQ/dk` per traversal.
+    pub d1: [f64; 4],
+    /// `d²Q/dk²` per traversal.
+    pub d2: [f64; 4],
 }
 
 /// The smallest and largest group path per unit thickness of one internal round trip,
 /// `d(k Re(q↑ − q↓))/dk` over the mode pairs (the phase index without dispersion).
-pub(crate) fn group_round_trips(optics: &SlabOptics, disp: &Dispersion, mu: f64) -> (f64, f64) {
+pub fn group_round_trips(optics: &SlabOptics, disp: &Dispersion, mu: f64) -> (f64, f64) {
     let m = optics.layer_modes();
     let trips = (0..2).flat_map(|a| {
         (0..2).map(move |b| (m.up[a].q - m.down[b].q).re + mu * (disp.d1[2 + a] + disp.d1[b]))
@@ -51,7 +48,7 @@ pub(crate) fn group_round_trips(optics: &SlabOptics, disp: &Dispersion, mu: f64)
 
 /// The largest difference of group path per unit thickness between the two modes travelling
 /// the same way, `d(k Re(q_o − q_e))/dk` (the direct paths' birefringent oscillation).
-pub(crate) fn group_splitting(optics: &SlabOptics, disp: &Dispersion, mu: f64) -> f64 {
+pub fn group_splitting(optics: &SlabOptics, disp: &Dispersion, mu: f64) -> f64 {
     let q = optics.layer_q();
     let g = |j: usize| q[j].re + mu * disp.d1[j] * if j < 2 { -1.0 } else { 1.0 };
     (g(0) - g(1)).abs().max((g(2) - g(3)).abs())

@@ -61,26 +61,56 @@ impl Group {
 }
 
 /// The layout of `lobe` up to `order` (at most [`MAX_ORDER`]); `absorbing` splits groups by
-/// their count sum. Built on first use.
-pub fn layout(lobe: Lobe, order: usize, absorbing: bool) -> &'static Layout {
+/// their count sum; without `cross_orders` only the pairs of classes of one order (a plate whose
+/// round trips are invisible needs no other). Built on first use.
+pub fn layout(lobe: Lobe, order: usize, absorbing: bool, cross_orders: bool) -> &'static Layout {
     const N: usize = MAX_ORDER + 1;
-    static ALL: [[[OnceLock<Layout>; 2]; N]; 2] =
-        [const { [const { [const { OnceLock::new() }; 2] }; N] }; 2];
+    type Layouts = [[OnceLock<Layout>; 2]; 2];
+    static ALL: [[Layouts; N]; 2] =
+        [const { [const { [const { [const { OnceLock::new() }; 2] }; 2] }; N] }; 2];
     let order = order.min(MAX_ORDER);
     let l = usize::from(lobe == Lobe::Transmission);
-    ALL[l][order][usize::from(absorbing)].get_or_init(|| Layout::build(lobe, order, absorbing))
+    ALL[l][order][usize::from(absorbing)][usize::from(cross_orders)]
+        .get_or_init(|| Layout::build(lobe, order, absorbing, cross_orders))
 }
 
-/// A pair of classes keyed for grouping: (orders, Δ counts, summed counts, class a, class b).
-type Keyed = ((usize, usize), [i32; 4], [i32; 4], u16, u16);
+/// A pair of classes keyed for grouping: its orders, `Δ` counts and summed counts packed into
+/// 6-bit fields of one `u64` in that order of significance (counts are at most
+/// `MAX_ORDER + 2`: `Δ + 32` and the sums fit), and the classes `(a, b)`: sorting the keys
+/// sorts by (orders, Δ, sum, a, b).
+type Keyed = (u64, u32);
+
+/// The packed key of [`Keyed`].
+fn key(orders: (usize, usize), delta: &[i32; 4], sum: &[i32; 4]) -> u64 {
+    let field = |k: u64, x: i64| (k << 6) | (x as u64 & 63);
+    let mut k = field(field(0, orders.0 as i64), orders.1 as i64);
+    for d in delta {
+        k = field(k, i64::from(*d) + 32);
+    }
+    for x in sum {
+        k = field(k, i64::from(*x));
+    }
+    k
+}
+
+/// The fields of a packed key: (orders, Δ, sum).
+fn unkey(k: u64) -> ((usize, usize), [i32; 4], [i32; 4]) {
+    let field = |i: u32| ((k >> (6 * i)) & 63) as i32;
+    let sum = [field(3), field(2), field(1), field(0)];
+    let delta = [field(7) - 32, field(6) - 32, field(5) - 32, field(4) - 32];
+    ((field(9) as usize, field(8) as usize), delta, sum)
+}
 
 impl Layout {
-    fn build(lobe: Lobe, order: usize, absorbing: bool) -> Self {
+    fn build(lobe: Lobe, order: usize, absorbing: bool, cross_orders: bool) -> Self {
         let n = lobe.classes(order);
         let classes: Vec<(Counts, usize)> = (0..n).map(|k| lobe.class(k)).collect();
-        let mut keyed: Vec<Keyed> = Vec::new();
+        let mut keyed: Vec<Keyed> = Vec::with_capacity(n * (n + 1) / 2);
         for a in 0..n {
             for b in a..n {
+                if !cross_orders && classes[a].1 != classes[b].1 {
+                    continue;
+                }
                 let (ca, cb) = (classes[a].0, classes[b].0);
                 let delta: [i32; 4] = std::array::from_fn(|m| i32::from(cb[m]) - i32::from(ca[m]));
                 let (delta, a, b) = if is_canonical(&delta) {
@@ -94,7 +124,10 @@ impl Layout {
                     [0; 4]
                 };
                 let (oa, ob) = (classes[a].1, classes[b].1);
-                keyed.push(((oa.min(ob), oa.max(ob)), delta, sum, a as u16, b as u16));
+                keyed.push((
+                    key((oa.min(ob), oa.max(ob)), &delta, &sum),
+                    ((a as u32) << 16) | b as u32,
+                ));
             }
         }
         keyed.sort_unstable();
@@ -105,9 +138,10 @@ impl Layout {
             counts: classes.iter().map(|c| c.0).collect(),
             orders: classes.iter().map(|c| c.1 as u8).collect(),
         };
-        for (orders, delta, sum, a, b) in keyed {
+        for (k, ab) in keyed {
+            let (orders, delta, sum) = unkey(k);
             let p = out.pairs.len();
-            out.pairs.push((a, b));
+            out.pairs.push(((ab >> 16) as u16, (ab & 0xffff) as u16));
             let new_block = out.blocks.last().is_none_or(|bl| bl.orders != orders);
             if new_block {
                 let g = out.groups.len();
@@ -148,16 +182,22 @@ fn is_canonical(d: &[i32; 4]) -> bool {
 mod tests {
     use super::*;
 
-    /// Every unordered pair of classes is laid out once, in the block of its orders and a group
-    /// whose count difference (and sum) it has.
+    /// Every unordered pair of classes (of one order, without `cross_orders`) is laid out once,
+    /// in the block of its orders and a group whose count difference (and sum) it has.
     #[test]
     fn every_pair_once_in_its_group() {
         for lobe in Lobe::BOTH {
-            for order in [0, 1, 3] {
-                for absorbing in [false, true] {
-                    let l = layout(lobe, order, absorbing);
+            for (order, absorbing, cross) in
+                (0..16).map(|i| ([0, 1, 3, 8][i / 4], i & 2 != 0, i & 1 != 0))
+            {
+                {
+                    let l = layout(lobe, order, absorbing, cross);
                     let n = lobe.classes(order);
-                    assert_eq!(l.pairs.len(), n * (n + 1) / 2);
+                    let same: usize = (0..n)
+                        .flat_map(|a| (a..n).map(move |b| (a, b)))
+                        .filter(|&(a, b)| cross || l.orders[a] == l.orders[b])
+                        .count();
+                    assert_eq!(l.pairs.len(), same);
                     let mut seen = vec![false; n * n];
                     for block in &l.blocks {
                         for g in &l.groups[block.groups.clone()] {

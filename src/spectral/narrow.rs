@@ -1,7 +1,7 @@
 //! A narrow band through a birefringent plate in closed form: the plate as a matrix etalon.
 //!
 //! Across a narrow band (σ ≪ μ) the interface amplitudes barely change (they are taken at the
-//! centre, as the pair sums of [`crate::spectral::integrate`] do) and each traversal of the
+//! centre, as the pair sums of [`crate::spectral::gaussian`] do) and each traversal of the
 //! layer in mode `j` has the phase `μ d Q_j + κ d G_j` at `k = μ + κ` (`G_j = Q_j + μ Q_j'`
 //! its group index). Write `G_j = ḡ + δ_j`: the common part `ḡ` is the fast phase of the
 //! internal round trips, `h = exp(2 i κ d ḡ)` per round trip; the residuals `δ_j` (the
@@ -32,10 +32,14 @@
 use crate::band::Gaussian;
 use crate::cmath;
 use crate::plate::slab::{SlabOptics, Want};
-use crate::spectral::hermite;
+use crate::quadrature::hermite;
 use nalgebra::{Matrix2, Matrix4};
 use num_complex::Complex64 as C64;
 
+/// Gaussians with `σ ≤ NARROW_BAND μ` (FWHM up to ~13 nm at 550 nm) are narrow: the closed form
+/// takes the interface amplitudes at the centre (they change by ~|dη/dλ| × band width, ~1e-5
+/// relative for 4 nm).
+pub const NARROW_BAND: f64 = 0.01;
 /// A mode attenuated by more than `exp(−ATTENUATED)` in one traversal carries nothing.
 const ATTENUATED: f64 = 40.0;
 /// Orders whose pair weight `g(Δ) ‖D‖^Δ` falls below this are dropped.
@@ -57,40 +61,81 @@ pub struct Traversal {
     pub curvature: f64,
 }
 
-/// The band-averaged Mueller matrices `(R, T)` (zero where not wanted) of the plate `optics`
-/// (solved at the band's centre) over the unit-mass Gaussian `g`, given how the phases of the
-/// four traversals `[o↓, e↓, o↑, e↑]` vary across it (`traversals`). `None` where the closed
-/// form does not apply (too many orders or nodes, or an order series that does not converge
-/// once shifted into the complex plane: plates near grazing incidence, very thick and strongly
-/// birefringent ones); the caller then uses the general method.
-pub fn band(
-    optics: &SlabOptics,
-    g: &Gaussian,
-    traversals: &[Traversal; 4],
-    want: Want,
-) -> Option<(Matrix4<f64>, Matrix4<f64>)> {
-    let plate = Layer::new(optics, g, traversals)?;
+/// Where the closed form serves the plate `optics` (solved at the band's centre) over the
+/// unit-mass Gaussian `g`, given how the phases of the four traversals `[o↓, e↓, o↑, e↑]` vary
+/// across it (`traversals`): the plate over the band with its orders and its Gauss–Hermite rule
+/// per order difference, checked once here so that [`band`] cannot fail. `None` where it does
+/// not serve (too many orders or nodes, or an order series that would not converge at some
+/// node once shifted into the complex plane: plates near grazing incidence, very thick and
+/// strongly birefringent ones); [`crate::spectral::route`] then chooses another method.
+pub fn plan(optics: &SlabOptics, g: &Gaussian, traversals: &[Traversal; 4]) -> Option<Narrow> {
+    if g.sigma > NARROW_BAND * g.mu {
+        return None;
+    }
+    let layer = Layer::new(optics, g, traversals)?;
+    let mut nodes = [0u8; MAX_TERMS + 1];
+    let mut count = 0;
+    for (delta, slot) in nodes.iter_mut().enumerate().take(layer.orders + 1) {
+        let gd = layer.coherence(delta);
+        if gd == 0.0 {
+            break;
+        }
+        // The pairs Δ orders apart weigh at most g(Δ) ‖D‖^Δ: their rule needs less accuracy.
+        let weight = gd * layer.rho.powi(delta as i32);
+        let phase = if delta == 0 {
+            layer.phase_same
+        } else {
+            layer.phase_orders
+        };
+        let n = hermite_nodes(phase, NODE_TOLERANCE / weight.max(1e-300))?;
+        let x = hermite::rule(n).last().map_or(0.0, |r| r.0);
+        if !layer.converges(g, delta, x) {
+            return None;
+        }
+        *slot = n as u8;
+        count = delta + 1;
+    }
+    Some(Narrow {
+        layer,
+        sigma: g.sigma,
+        nodes,
+        count,
+    })
+}
+
+/// The closed form of one plate over one band, as [`plan`] checked it.
+pub struct Narrow {
+    layer: Layer,
+    sigma: f64,
+    /// Gauss–Hermite nodes per order difference `Δ < count`.
+    nodes: [u8; MAX_TERMS + 1],
+    count: usize,
+}
+
+impl Narrow {
+    /// The exact plate evaluations (complex nodes) the closed form costs.
+    pub fn nodes(&self) -> usize {
+        self.nodes[..self.count]
+            .iter()
+            .map(|&n| usize::from(n))
+            .sum()
+    }
+}
+
+/// The band-averaged Mueller matrices `(R, T)` (zero where not wanted) of the plan `n`.
+pub fn band(n: &Narrow, want: Want) -> (Matrix4<f64>, Matrix4<f64>) {
+    let plate = &n.layer;
+    let sigma = n.sigma;
     let mut c_t = Matrix4::<C64>::zeros();
     let mut c_r = Matrix4::<C64>::zeros();
     let mut mirrored_t = Matrix4::<C64>::zeros();
     let mut mirrored_r = Matrix4::<C64>::zeros();
     let t1_bar = plate.t1.map(|z| z.conj());
-    for delta in 0..=plate.orders {
+    for delta in 0..n.count {
         let gd = plate.coherence(delta);
-        if gd == 0.0 {
-            break;
-        }
-        // The pairs Δ orders apart weigh at most g(Δ) ‖D‖^Δ: their rule needs less accuracy.
-        let weight = gd * plate.rho.powi(delta as i32);
-        let phase = if delta == 0 {
-            plate.phase_same
-        } else {
-            plate.phase_orders
-        };
-        let nodes = hermite_nodes(phase, NODE_TOLERANCE / weight.max(1e-300))?;
-        for &(x, w) in hermite::rule(nodes) {
-            let z = C64::new(g.sigma * x, g.sigma * g.sigma * plate.fast(delta));
-            let m = plate.at(z)?;
+        for &(x, w) in hermite::rule(usize::from(n.nodes[delta])) {
+            let z = C64::new(sigma * x, sigma * sigma * plate.fast(delta));
+            let m = plate.at(z);
             // (I ⊗ D^Δ)(t̄₁ ⊗ t₁) = t̄₁ ⊗ D^Δ t₁.
             let before = power(&m.d, delta.saturating_sub(1)); // D^(Δ−1), also for R below
             let dt1 = if delta == 0 {
@@ -99,7 +144,9 @@ pub fn band(
                 m.d * before * plate.t1
             };
             let rhs = kron(&t1_bar, &dt1);
-            let y = cmath::solve4(&(Matrix4::identity() - kron(&m.d_bar, &m.d)), &rhs)?;
+            // The series converges here ([`Layer::converges`]): the system is regular.
+            let y = cmath::solve4(&(Matrix4::identity() - kron(&m.d_bar, &m.d)), &rhs)
+                .expect("regular: ‖D̄ ⊗ D‖ < 1 at every node, checked by the plan");
             let weight = C64::new(w * gd, 0.0);
             let (target_t, target_r) = if delta == 0 {
                 (&mut c_t, &mut c_r)
@@ -136,7 +183,7 @@ pub fn band(
     } else {
         Matrix4::zeros()
     };
-    Some((r, t))
+    (r, t)
 }
 
 /// The plate over one band: centre amplitudes, residual rates and the rule's sizes.
@@ -218,7 +265,10 @@ impl Layer {
             phase_orders: 0.0,
             rho: 0.0,
         };
-        let rho = layer.at(C64::new(0.0, 0.0))?.d.norm();
+        let rho = layer.at(C64::new(0.0, 0.0)).d.norm();
+        if rho >= 1.0 {
+            return None;
+        }
         layer.rho = rho;
         layer.orders = (1..=MAX_TERMS)
             .find(|&n| layer.coherence(n) * rho.powi(n as i32) < SERIES_TOLERANCE)?;
@@ -252,9 +302,19 @@ impl Layer {
         self.round_trip * delta as f64
     }
 
-    /// Amplitudes at the complex node `z` (the continuation of `κ`). `None` if the order series
-    /// would not converge there.
-    fn at(&self, z: C64) -> Option<AtNode> {
+    /// True if the order series converges (`‖D‖ ‖D̄‖ < 1`, Frobenius norms) at every node
+    /// `z = σ x + i σ² a` (`a` the fast group path of `delta` round trips) with `|x| ≤ x_max`:
+    /// each entry's modulus is log-linear in `x`, so both norms are log-convex in it and their
+    /// product is largest at `±x_max`.
+    fn converges(&self, g: &Gaussian, delta: usize, x_max: f64) -> bool {
+        [-x_max, x_max].iter().all(|&x| {
+            let m = self.at(C64::new(g.sigma * x, g.sigma * g.sigma * self.fast(delta)));
+            m.d.norm() * m.d_bar.norm() < 1.0
+        })
+    }
+
+    /// Amplitudes at the complex node `z` (the continuation of `κ`).
+    fn at(&self, z: C64) -> AtNode {
         let i = C64::new(0.0, 1.0);
         // exp(i (z r_j + z² c_j/2)) and the continuation of its conjugate.
         let ph: [C64; 4] = std::array::from_fn(|j| {
@@ -270,17 +330,14 @@ impl Layer {
         let c = |m: &Matrix2<C64>| m.map(|z| z.conj());
         let d = self.r3 * pu * self.r2 * pd;
         let d_bar = c(&self.r3) * pub_ * c(&self.r2) * pdb;
-        if d.norm() * d_bar.norm() >= 1.0 {
-            return None;
-        }
-        Some(AtNode {
+        AtNode {
             d,
             d_bar,
             x: self.t2 * pd,
             x_bar: c(&self.t2) * pdb,
             v: self.t3 * pu * self.r2 * pd,
             v_bar: c(&self.t3) * pub_ * c(&self.r2) * pdb,
-        })
+        }
     }
 }
 

@@ -1,17 +1,23 @@
-//! What a plate at one incidence looks like across the visible band, before any method is
-//! chosen: its interface blocks at the amplitude nodes ([`Amplitudes`]) and the invariants read
-//! off them (the traversals' group paths and attenuation rates, the least attenuation, the
-//! round trip's reflectance). [`crate::spectral::route`] decides from these alone; every
-//! method then starts from the same solved blocks.
+//! What a plate at one incidence looks like before any method is chosen, across the visible band
+//! ([`Survey`]: its interface blocks at the amplitude nodes, [`Amplitudes`], and the invariants
+//! read off them: the traversals' group paths and attenuation rates, the least attenuation, the
+//! round trip's reflectance) or around the centre of one Gaussian of a band ([`BandSurvey`]).
+//! [`crate::spectral::route`] decides from these alone; every method then starts from the same
+//! solved blocks, and nothing is solved again to decide.
 
+use crate::band::Gaussian;
 use crate::cmath::spectral_norm;
 use crate::error::Result;
 use crate::optics::frame::PlaneFrame;
+use crate::plate::slab::SlabOptics;
 use crate::plate::Plate;
+use crate::quadrature::budget::ATTENUATED;
+use crate::quadrature::fringe;
+use crate::quadrature::nodes::{self, SPAN};
 use crate::spectral::amplitudes::{least_attenuation, Amplitudes};
-use crate::spectral::budget::ATTENUATED;
-use crate::spectral::fringe;
-use crate::spectral::nodes::{self, SPAN};
+use crate::spectral::group::{dispersion, group_round_trips, Dispersion};
+use crate::spectral::narrow::{self, Narrow};
+use nalgebra::Matrix2;
 use num_complex::Complex64 as C64;
 use std::f64::consts::TAU;
 
@@ -36,10 +42,16 @@ pub struct Survey<'a> {
     /// layer's wave turns evanescent inside the band
     /// ([`crate::spectral::amplitudes::least_attenuation`]).
     pub loss: Option<[f64; 4]>,
-    /// An upper bound, over the band, of the spectral norm of one internal round trip
-    /// `r₃ P↑ r₂ P↓`: `‖r₃‖ ‖r₂‖` times the largest attenuation factors (the norm of the `n`-th
-    /// round trip is at most `ρⁿ`).
+    /// The decay per internal round trip `D = r₃ P↑ r₂ P↓` over the band: the largest
+    /// `‖D⁸‖^{1/8}` at the amplitude nodes (spectral norms; with [`Survey::transient`], the norm
+    /// of the `n`-th round trip is at most `C ρⁿ`). The flux-normalised blocks of a tilted
+    /// crystal are not unitary in this basis: near grazing incidence `‖r₃‖ ‖r₂‖`, even `‖D‖`,
+    /// can exceed 1 (calcite 90 µm at 89.5°: 1.049) while the round trips decay (`‖D⁸‖^{1/8}`
+    /// 0.97), so one round trip's norm would not bound the orders.
     pub rho: f64,
+    /// `C = max_{k ≤ 8} ‖Dᵏ‖/ρᵏ` over the nodes (at least 1): the transient growth of the first
+    /// round trips over the decay `ρ`.
+    pub transient: f64,
 }
 
 impl<'a> Survey<'a> {
@@ -51,7 +63,7 @@ impl<'a> Survey<'a> {
         let group_path = at[SPAN.len() / 2].map(|g| g * d);
         let group_paths = at.map(|g| g.map(|x| x.re * d));
         let loss = least_attenuation(plate, &amplitudes);
-        let rho = round_trip_bound(&amplitudes);
+        let (rho, transient) = round_trip_decay(&amplitudes);
         Ok(Survey {
             plate,
             frame,
@@ -61,6 +73,7 @@ impl<'a> Survey<'a> {
             group_paths,
             loss,
             rho,
+            transient,
         })
     }
 
@@ -91,18 +104,127 @@ impl<'a> Survey<'a> {
     }
 }
 
-/// `max over the amplitude nodes of ‖r₃‖ ‖r₂‖ max|P↑| max|P↓|` (spectral norms).
-fn round_trip_bound(amplitudes: &Amplitudes) -> f64 {
+/// `(ρ, C)` of [`Survey::rho`] and [`Survey::transient`] from the round trips at the amplitude
+/// nodes (`D`, `D²`, … `D⁸` by products); where every `D⁸` vanishes (a round trip that dies in
+/// a few bounces), `ρ = max ‖r₃‖ ‖r₂‖ max|P↑| max|P↓|` and `C = 1`.
+fn round_trip_decay(amplitudes: &Amplitudes) -> (f64, f64) {
     let (k0, a) = fringe::band();
     let lv = nodes::level(amplitudes.level);
-    lv.in_finest
+    // `‖Dᵏ‖`, k = 1..8, at each node (a fixed array: a query allocates nothing).
+    let mut powers = [[0.0f64; 8]; nodes::MAX_NODES];
+    let mut crude = 0.0f64;
+    for ((&j, t), norms) in lv.in_finest.iter().zip(&lv.nodes).zip(powers.iter_mut()) {
+        let b = amplitudes.exact(j).expect("an amplitude node");
+        let (pd, pu) = b.propagation(TAU / (k0 + a * t));
+        let most = |p: [C64; 2]| p[0].norm().max(p[1].norm());
+        crude = crude.max(spectral_norm(&b.r3) * spectral_norm(&b.r2) * most(pd) * most(pu));
+        let diag = |p: [C64; 2]| Matrix2::new(p[0], C64::new(0.0, 0.0), C64::new(0.0, 0.0), p[1]);
+        let d = b.r3 * diag(pu) * b.r2 * diag(pd);
+        let mut dk = d;
+        for (k, n) in norms.iter_mut().enumerate() {
+            if k > 0 {
+                dk *= d;
+            }
+            *n = spectral_norm(&dk);
+        }
+    }
+    let powers = &powers[..lv.nodes.len()];
+    let rho = powers
         .iter()
-        .zip(&lv.nodes)
-        .map(|(&j, t)| {
-            let b = amplitudes.exact(j).expect("an amplitude node");
-            let (pd, pu) = b.propagation(TAU / (k0 + a * t));
-            let most = |p: [C64; 2]| p[0].norm().max(p[1].norm());
-            spectral_norm(&b.r3) * spectral_norm(&b.r2) * most(pd) * most(pu)
+        .map(|n| n[7].powf(1.0 / 8.0))
+        .fold(0.0, f64::max);
+    if rho.is_nan() || rho <= 0.0 {
+        return (crude, 1.0);
+    }
+    let transient = powers
+        .iter()
+        .flat_map(|n| {
+            n.iter()
+                .enumerate()
+                .map(|(k, x)| x / rho.powi(k as i32 + 1))
         })
-        .fold(0.0, f64::max)
+        .fold(1.0, f64::max);
+    (rho, transient)
+}
+
+/// Orders are counted until the round trip's amplitude falls below this ([`BandSurvey::orders`]).
+pub const ORDER_TOLERANCE: f64 = 1e-5;
+/// Most round trips [`BandSurvey::orders`] counts.
+pub const MAX_ORDERS: usize = 2000;
+
+/// A plate at one incidence around the centre `μ` of one unit-mass Gaussian of a band: what
+/// [`crate::spectral::route::gaussian`] decides from and the band's methods
+/// ([`crate::spectral::gaussian`]) start from.
+pub struct BandSurvey<'a> {
+    /// The plate.
+    pub plate: &'a Plate,
+    /// Its plane of incidence.
+    pub frame: PlaneFrame,
+    /// The incidence parameter.
+    pub beta: C64,
+    /// The Gaussian.
+    pub g: Gaussian,
+    /// The plate solved at the centre (for every Gaussian, without dispersion).
+    pub optics: SlabOptics,
+    /// The traversals' phase derivatives at the centre.
+    pub dispersion: Dispersion,
+    /// The smallest and largest group path per unit thickness of one round trip.
+    pub round_trips: (f64, f64),
+    /// Round trips until the amplitude falls below [`ORDER_TOLERANCE`] (at most
+    /// [`MAX_ORDERS`]).
+    pub orders: usize,
+    /// The narrow-band closed form, where it serves ([`narrow::plan`]).
+    pub narrow: Option<Narrow>,
+}
+
+impl<'a> BandSurvey<'a> {
+    /// The survey of `plate` over `g`, its interfaces at the centre `optics`.
+    pub fn new(
+        plate: &'a Plate,
+        frame: PlaneFrame,
+        beta: C64,
+        g: &Gaussian,
+        optics: SlabOptics,
+    ) -> Result<Self> {
+        let dispersion = dispersion(plate, &frame, beta, g.mu)?;
+        let traversals = traversals(&optics, &dispersion, g.mu);
+        Ok(BandSurvey {
+            plate,
+            frame,
+            beta,
+            g: *g,
+            round_trips: group_round_trips(&optics, &dispersion, g.mu),
+            orders: orders(&optics, TAU / g.mu),
+            narrow: narrow::plan(&optics, g, &traversals),
+            optics,
+            dispersion,
+        })
+    }
+}
+
+/// How each traversal's phase varies around `mu` ([`narrow::Traversal`]), from the modes at
+/// the centre and the dispersion derivatives.
+fn traversals(optics: &SlabOptics, disp: &Dispersion, mu: f64) -> [narrow::Traversal; 4] {
+    let m = optics.layer_modes();
+    let q = [-m.down[0].q, -m.down[1].q, m.up[0].q, m.up[1].q];
+    std::array::from_fn(|j| narrow::Traversal {
+        group: q[j] + mu * disp.d1[j],
+        curvature: 2.0 * disp.d1[j] + mu * disp.d2[j],
+    })
+}
+
+/// Round trips until the internal amplitude `‖r₃ P↑ r₂ P↓‖` (Frobenius, at `lambda`) falls
+/// below [`ORDER_TOLERANCE`], at most [`MAX_ORDERS`].
+fn orders(optics: &SlabOptics, lambda: f64) -> usize {
+    let (pd, pu) = optics.propagation(lambda);
+    let rho = (optics.top.r_below() * pu * optics.bottom.r_above() * pd).norm();
+    if rho <= 0.0 {
+        0
+    } else if rho >= 1.0 {
+        MAX_ORDERS
+    } else {
+        ((ORDER_TOLERANCE.ln() / rho.ln()).ceil() as usize)
+            .saturating_sub(1)
+            .min(MAX_ORDERS)
+    }
 }

@@ -38,7 +38,7 @@ use nalgebra::{Matrix2, Matrix4};
 use num_complex::Complex64 as C64;
 
 /// How each layer of a stack is treated for one spectrum (decided by
-/// [`crate::stack::plan::Plan`]).
+/// [`crate::stack::plan::StackPlan`]).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Coherence {
     /// Per layer: its round trips are incoherent.
@@ -154,23 +154,69 @@ pub fn mueller(
         let (pd, pu) = phase_factors(blocks.thickness_nm[j], lambda_nm, &blocks.q[j]);
         let keep = coherence.keep_modes[j];
         let (md, mu) = (diagonal(pd, keep), diagonal(pu, keep));
-        let g = mu * gamma * md;
-        let t = tau * md;
+        // M(P) is block diagonal (2×2 blocks on modes 0-1 and 2-3): multiplied by its blocks.
+        let g = times_diagonal(&diagonal_times(&mu, &gamma), &md);
+        let t = times_diagonal(&tau, &md);
         let seg = match prepared.above[k] {
             Some(s) => s,
             None => segment(blocks, a, j, lambda_nm)?.map(|m| mueller::from_jones(&m)),
         };
-        let d = (Matrix4::identity() - seg[R_UP] * g)
+        let d = (Matrix4::identity() - mul4(&seg[R_UP], &g))
             .try_inverse()
             .ok_or_else(resonance)?;
-        let y = d * seg[T_DOWN];
-        tau = t * y;
-        gamma = seg[R_DOWN] + seg[T_UP] * g * y;
+        let y = mul4(&d, &seg[T_DOWN]);
+        tau = mul4(&t, &y);
+        gamma = seg[R_DOWN] + mul4(&seg[T_UP], &mul4(&g, &y));
     }
     Ok(SlabMueller {
         r: want.reflection.then_some(gamma),
         t: want.transmission.then(|| tau * blocks.flux),
     })
+}
+
+/// `a b` of real 4×4 matrices, written out on the column-major storage (the generic product
+/// does not unroll).
+#[inline]
+fn mul4(a: &Matrix4<f64>, b: &Matrix4<f64>) -> Matrix4<f64> {
+    let (a, b) = (a.as_slice(), b.as_slice());
+    let mut out = [0.0; 16];
+    for j in 0..4 {
+        for i in 0..4 {
+            out[4 * j + i] = a[i] * b[4 * j]
+                + a[4 + i] * b[4 * j + 1]
+                + a[8 + i] * b[4 * j + 2]
+                + a[12 + i] * b[4 * j + 3];
+        }
+    }
+    Matrix4::from_column_slice(&out)
+}
+
+/// `D m` for `D` block diagonal ([`diagonal`]: rows 0-1 and 2-3 mix in pairs).
+#[inline]
+fn diagonal_times(d: &Matrix4<f64>, m: &Matrix4<f64>) -> Matrix4<f64> {
+    let (d, m) = (d.as_slice(), m.as_slice());
+    let mut out = [0.0; 16];
+    for j in 0..4 {
+        for i in 0..4 {
+            let b = i & !1;
+            out[4 * j + i] = d[4 * b + i] * m[4 * j + b] + d[4 * (b + 1) + i] * m[4 * j + b + 1];
+        }
+    }
+    Matrix4::from_column_slice(&out)
+}
+
+/// `m D` for `D` block diagonal ([`diagonal`]: columns 0-1 and 2-3 mix in pairs).
+#[inline]
+fn times_diagonal(m: &Matrix4<f64>, d: &Matrix4<f64>) -> Matrix4<f64> {
+    let (m, d) = (m.as_slice(), d.as_slice());
+    let mut out = [0.0; 16];
+    for j in 0..4 {
+        let b = j & !1;
+        for i in 0..4 {
+            out[4 * j + i] = m[4 * b + i] * d[4 * j + b] + m[4 * (b + 1) + i] * d[4 * j + b + 1];
+        }
+    }
+    Matrix4::from_column_slice(&out)
 }
 
 /// `M(diag(a, b))` in the convention of [`mueller::from_jones`] (written out: `v = a b̄`), with
@@ -260,11 +306,17 @@ fn star(a: &[Matrix2<C64>; 4], b: &[Matrix2<C64>; 4]) -> Result<[Matrix2<C64>; 4
 mod tests {
     use super::*;
 
-    /// The written-out diagonal Mueller matrix is `from_jones` of the diagonal Jones matrix.
+    /// The written-out diagonal Mueller matrix is `from_jones` of the diagonal Jones matrix,
+    /// and the written-out products are the products.
     #[test]
     fn diagonal_is_from_jones() {
         let (a, b) = (C64::new(0.3, -0.7), C64::new(-0.2, 0.5));
         let m = mueller::from_jones(&Matrix2::new(a, C64::new(0.0, 0.0), C64::new(0.0, 0.0), b));
-        assert!((diagonal([a, b], true) - m).norm() < 1e-15);
+        let d = diagonal([a, b], true);
+        assert!((d - m).norm() < 1e-15);
+        let x = Matrix4::from_fn(|i, j| ((3 * i + 7 * j) % 11) as f64 - 4.5);
+        assert!((mul4(&x, &d.transpose()) - x * d.transpose()).norm() < 1e-13);
+        assert!((diagonal_times(&d, &x) - d * x).norm() < 1e-13);
+        assert!((times_diagonal(&x, &d) - x * d).norm() < 1e-13);
     }
 }

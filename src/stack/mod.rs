@@ -11,12 +11,13 @@
 //!   stack's spectrum oscillates;
 //! * [`spectral`]: the stack over colour channels and narrow bands (a dispersive stack's
 //!   interface blocks interpolated across a spectrum by the plate's Chebyshev series,
-//!   [`crate::spectral::interpolate::Interpolant`]).
+//!   [`crate::quadrature::interpolate::Interpolant`]).
 
 pub mod coherence;
 pub mod exact;
 pub mod plan;
 pub mod spectral;
+pub mod survey;
 
 use crate::error::{Error, Result};
 use crate::material::{check_clear_index, Material};

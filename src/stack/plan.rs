@@ -18,17 +18,17 @@
 //! other kept layer could make up (a term of the Mueller matrix with one internal round trip
 //! traverses a layer at most three times): then its cross term is invisible and dropped.
 //!
-//! **Frequencies** for the rules (as [`crate::spectral::shared::points`] takes them): the direct
+//! **Frequencies** for the rules (as [`crate::quadrature::chebyshev::points`] takes them): the direct
 //! light oscillates at most at `ω_b = Σ_j split_j` (coherent layers; thick ones only if their
 //! modes are kept), each further round trip adds at most `ω₁ = 2 (Σ_thin path_j + Σ_thick split_j)`,
 //! with a relative strength `ρ = Σ_{i<l} ρ_il` over pairs of interfaces: `r_i r_l` (flux
 //! amplitudes, the largest of either side) when only thin layers lie between them, `r_i² r_l²`
 //! (powers) when a thick one does.
 
+use crate::colour::weights::{gaussians, WeightSet};
 use crate::error::Result;
 use crate::optics::frame::PlaneFrame;
-use crate::spectral::shared::TOLERANCE;
-use crate::spectral::weights::{gaussians, WeightSet};
+use crate::quadrature::chebyshev::TOLERANCE;
 use crate::stack::coherence::Coherence;
 use crate::stack::exact::{interfaces, layer_q};
 use crate::stack::Stack;
@@ -36,7 +36,7 @@ use num_complex::Complex64 as C64;
 use std::f64::consts::TAU;
 
 /// Visibility below which a fringe is invisible (relative to the white response; the
-/// threshold of the fringe tables, [`crate::spectral::fringe::NEGLIGIBLE`]).
+/// threshold of the fringe tables, [`crate::quadrature::fringe::NEGLIGIBLE`]).
 pub const NEGLIGIBLE: f64 = 1e-7;
 
 /// The reach of one Gaussian of mass `a` and width `sigma` (rad/nm).
@@ -44,7 +44,7 @@ pub fn reach_of_gaussian(a: f64, sigma: f64) -> f64 {
     (2.0 * (a / NEGLIGIBLE).ln()).sqrt() / sigma
 }
 
-/// Largest visibility of a round trip [`Plan::thicken`] sums incoherently: its orders' cross
+/// Largest visibility of a round trip [`StackPlan::thicken`] sums incoherently: its orders' cross
 /// terms, at most this fraction of the light they carry, are dropped.
 pub const THICKEN: f64 = 1e-3;
 
@@ -61,7 +61,7 @@ pub struct LayerPaths {
 
 /// The plan of one stack, incidence and spectrum.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Plan {
+pub struct StackPlan {
     /// Which layers are thick and whose modes stay coherent.
     pub coherence: Coherence,
     /// Largest frequency of the direct light (nm).
@@ -201,7 +201,7 @@ impl Weight {
     }
 }
 
-impl Plan {
+impl StackPlan {
     /// The plan for `weight`, from the layers' group paths `paths` and the interfaces'
     /// reflectances `reflectance`; `exact`: every layer coherent (the exact stack). A layer is
     /// thick when the strongest round trip across it, `r_i r_l` over the interfaces `i` above
@@ -252,7 +252,7 @@ impl Plan {
                 };
             }
         }
-        Plan {
+        StackPlan {
             coherence: Coherence { thick, keep_modes },
             omega_b,
             omega_1: 2.0 * per_trip,
@@ -323,16 +323,16 @@ mod tests {
         let r = [0.04, 0.0, 0.04];
         let w = Weight::of_set(WeightSet::XyzD65);
         let zero_order = [paths(9_500.0, 3e6), paths(9_400.0, 3e6)];
-        let p = Plan::new(&zero_order, &r, &w, false);
+        let p = StackPlan::new(&zero_order, &r, &w, false);
         assert_eq!(p.coherence.thick, vec![true, true]);
         assert_eq!(p.coherence.keep_modes, vec![true, true]);
         let lone = [paths(170_000.0, 3e6), paths(100.0, 3e3)];
         assert!(w.reach() > 3e3 && w.reach() < 3e6);
-        let p = Plan::new(&lone, &r, &w, false);
+        let p = StackPlan::new(&lone, &r, &w, false);
         assert_eq!(p.coherence.thick, vec![true, false]);
         assert_eq!(p.coherence.keep_modes, vec![false, true]);
         assert!((p.omega_b - 100.0).abs() < 1e-9);
-        let exact = Plan::new(&lone, &r, &w, true);
+        let exact = StackPlan::new(&lone, &r, &w, true);
         assert!(exact.coherence.is_exact());
         // Reflections across a thick layer count as powers, within thin ones as amplitudes.
         assert!((p.rho - (0.04f64 * 0.04)).abs() < 1e-12);

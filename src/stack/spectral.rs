@@ -1,10 +1,10 @@
 //! A stack integrated over colour channels and narrow bands (docs/physics.md §8).
 //!
 //! **Channels** (a weight set's three Gaussian fits): the model of [`crate::stack::coherence`]
-//! under the set's [`Plan`] (thick layers' round trips incoherent) evaluated at the Chebyshev
-//! points of the shared product-integration rule [`shared::rule`], whose point count
-//! [`shared::points`] takes from the plan's frequencies: every oscillation of amplitude `a` is
-//! integrated to `a · error ≤ 1e-5` of the light ([`shared::TOLERANCE`]), at most 1024 points
+//! under the set's [`StackPlan`] (thick layers' round trips incoherent) evaluated at the Chebyshev
+//! points of the shared product-integration rule [`chebyshev::rule`], whose point count
+//! [`chebyshev::points`] takes from the plan's frequencies: every oscillation of amplitude `a` is
+//! integrated to `a · error ≤ 1e-5` of the light ([`chebyshev::TOLERANCE`]), at most 1024 points
 //! (a stack that needs more, rare once invisible cross terms are dropped, takes 1024). Each
 //! point serves all three channels. A dispersive stack's interface blocks are interpolated
 //! across the rule's support ([`Interpolant`]), its phases computed exactly at every point.
@@ -12,7 +12,7 @@
 //! **A narrow band** (one Gaussian `N(μ, σ)`, the plugins' `filter_bandwidth`): the same
 //! model under the band's plan, by composite 8-point Gauss–Legendre panels over `μ ± 6.5σ` with
 //! at most half a period of the fastest significant oscillation per panel (`a_n ≥ 1e-5`,
-//! [`shared::points`]'s amplitudes), at least 16 panels.
+//! [`chebyshev::points`]'s amplitudes), at least 16 panels.
 //!
 //! **Exact** ([`Accuracy::Exact`]): every layer coherent (the exact stack) at the Chebyshev
 //! points; refused (naming `spectrum.method`) if more than 1024 are needed.
@@ -22,17 +22,20 @@
 //! stacks): mean CIEDE2000 ≤ 0.1, worst ≤ 0.5, as for one plate.
 
 use crate::band::Gaussian;
+use crate::colour::weights::WeightSet;
 use crate::error::{Error, Result};
 use crate::optics::frame::PlaneFrame;
 use crate::plate::slab::{Output, SlabMueller, Want};
-use crate::spectral::hermite;
-use crate::spectral::interpolate::{self, Interpolant};
-use crate::spectral::model::Accuracy;
-use crate::spectral::shared::{self, LADDER, TOLERANCE};
-use crate::spectral::weights::{gaussians, WeightSet};
+use crate::quadrature::chebyshev::{self, TOLERANCE};
+use crate::quadrature::hermite;
+use crate::quadrature::interpolate::{self, Interpolant};
+use crate::quadrature::Accuracy;
+use crate::spectral::model::ThinModel;
+use crate::spectral::route::{self, Route};
 use crate::stack::coherence::{self, Coherence, Prepared};
 use crate::stack::exact::{layer_q_into, StackBlocks};
-use crate::stack::plan::{layer_paths, reflectances, LayerPaths, Plan, Weight};
+use crate::stack::plan::{layer_paths, reflectances, LayerPaths, StackPlan, Weight};
+use crate::stack::survey::StackSurvey;
 use crate::stack::Stack;
 use nalgebra::Matrix4;
 use num_complex::Complex64 as C64;
@@ -88,17 +91,8 @@ impl<'a> StackModel<'a> {
         Ok(self.fixed.get_or_init(|| b).clone())
     }
 
-    /// Exactly at `lambda_nm` (s/p frames, power fractions).
-    pub fn at(&self, lambda_nm: f64, want: Want, output: Output) -> Result<SlabMueller> {
-        let m = match self.fixed.get() {
-            Some(b) if !self.stack.is_dispersive() => b.mueller(lambda_nm, want)?,
-            _ => self.blocks(lambda_nm)?.mueller(lambda_nm, want)?,
-        };
-        Ok(output.keep(m))
-    }
-
     /// The layers' group paths at wavenumbers `ks` and the interfaces' reflectances at the
-    /// first of them: what [`Plan`]s are made of.
+    /// first of them: what [`StackPlan`]s are made of.
     pub fn paths(&self, ks: &[f64]) -> Result<(Vec<LayerPaths>, Vec<f64>)> {
         Ok((
             layer_paths(self.stack, &self.frame, self.beta, ks)?,
@@ -107,14 +101,14 @@ impl<'a> StackModel<'a> {
     }
 
     /// The plan for `weight`, the group paths taken at wavenumbers `ks`.
-    pub fn plan(&self, ks: &[f64], weight: &Weight, exact: bool) -> Result<Plan> {
+    pub fn plan(&self, ks: &[f64], weight: &Weight, exact: bool) -> Result<StackPlan> {
         let (paths, r) = self.paths(ks)?;
-        Ok(Plan::new(&paths, &r, weight, exact))
+        Ok(StackPlan::new(&paths, &r, weight, exact))
     }
 
-    /// Over the Gaussian band `g` (module docs): the partially coherent model at
-    /// [`Accuracy::Perceptual`], the exact stack at [`Accuracy::Exact`].
-    pub fn band(
+    /// Over the unit-mass Gaussian `g` times its amplitude (module docs): the partially
+    /// coherent model at [`Accuracy::Perceptual`], the exact stack at [`Accuracy::Exact`].
+    fn gaussian(
         &self,
         g: &Gaussian,
         want: Want,
@@ -136,57 +130,6 @@ impl<'a> StackModel<'a> {
         let (lo, hi) = (g.mu - 6.5 * g.sigma, g.mu + 6.5 * g.sigma);
         let [m, _, _] = self.quadrature(&nodes, (lo, hi), &plan.coherence, want, output)?;
         Ok(m)
-    }
-
-    /// Over the three channels of `set`: the partially coherent model at
-    /// [`Accuracy::Perceptual`], the exact stack at [`Accuracy::Exact`] (module docs).
-    pub fn channels(
-        &self,
-        set: WeightSet,
-        want: Want,
-        output: Output,
-        accuracy: Accuracy,
-    ) -> Result<[SlabMueller; 3]> {
-        let (lo, hi) = shared::support(set);
-        let bulk = (0..3)
-            .flat_map(|c| gaussians(set, c).iter())
-            .map(|g| g.mu + 3.0 * g.sigma)
-            .fold(0.0, f64::max)
-            .min(hi);
-        let exact = accuracy == Accuracy::Exact;
-        let weight = Weight::of_set(set);
-        let (paths, r) = self.paths(&[0.5 * (lo + hi), bulk])?;
-        let mut plan = Plan::new(&paths, &r, &weight, exact);
-        let points = |p: &Plan| shared::points(set, p.omega_1, p.omega_b, p.rho);
-        // Too many coherent orders for any rule: the longest round trips become incoherent.
-        while points(&plan).is_none() && !exact {
-            match plan.thicken(&paths, &r, &weight) {
-                Some(p) => plan = p,
-                None => break,
-            }
-        }
-        let points = match (points(&plan), exact) {
-            (Some(p), _) => p,
-            (None, false) => LADDER[LADDER.len() - 1],
-            (None, true) => {
-                return Err(Error::new(
-                    "spectrum.method",
-                    format!(
-                        "the exact stack oscillates too fast across the visible for the exact rule \
-                         (more than {} points); use \"analytic\" or \"quadrature\"",
-                        LADDER[LADDER.len() - 1]
-                    ),
-                ))
-            }
-        };
-        let rule = shared::rule(set, points);
-        self.quadrature(
-            &rule.nodes,
-            (rule.lo, rule.hi),
-            &plan.coherence,
-            want,
-            output,
-        )
     }
 
     /// `Σ_j w_cj M(k_j)` over `nodes` `(k_j, [w_cj])` inside `support`, of the model under
@@ -259,6 +202,120 @@ impl<'a> StackModel<'a> {
     }
 }
 
+impl ThinModel for StackModel<'_> {
+    /// Exactly at `lambda_nm` (s/p frames, power fractions).
+    fn at(&self, lambda_nm: f64, want: Want, output: Output) -> Result<SlabMueller> {
+        let m = match self.fixed.get() {
+            Some(b) if !self.stack.is_dispersive() => b.mueller(lambda_nm, want)?,
+            _ => self.blocks(lambda_nm)?.mueller(lambda_nm, want)?,
+        };
+        Ok(output.keep(m))
+    }
+
+    /// Gaussian by Gaussian (module docs).
+    fn band(
+        &self,
+        band: &[Gaussian],
+        want: Want,
+        output: Output,
+        accuracy: Accuracy,
+    ) -> Result<SlabMueller> {
+        let (mut r, mut t) = (Matrix4::zeros(), Matrix4::zeros());
+        for g in band {
+            let m = self.gaussian(g, want, output, accuracy)?;
+            r += m.r.unwrap_or_default();
+            t += m.t.unwrap_or_default();
+        }
+        Ok(SlabMueller {
+            r: want.reflection.then_some(r),
+            t: want.transmission.then_some(t),
+        })
+    }
+
+    /// Over the three channels of `set`: the partially coherent model at
+    /// [`Accuracy::Perceptual`], the exact stack at [`Accuracy::Exact`] (module docs).
+    fn channels(
+        &self,
+        set: WeightSet,
+        want: Want,
+        output: Output,
+        accuracy: Accuracy,
+    ) -> Result<[SlabMueller; 3]> {
+        let exact = accuracy == Accuracy::Exact;
+        let survey = StackSurvey::new(self.stack, self.frame, self.beta)?;
+        let weight = Weight::of_set(set);
+        let paths = survey.layer_paths(set);
+        let r = &survey.reflectance;
+        let mut plan = StackPlan::new(&paths, r, &weight, exact);
+        let points = |p: &StackPlan| chebyshev::points(set, p.omega_1, p.omega_b, p.rho, 1.0);
+        // Too many coherent orders for any rule: the longest round trips become incoherent.
+        while points(&plan).is_none() && !exact {
+            match plan.thicken(&paths, r, &weight) {
+                Some(p) => plan = p,
+                None => break,
+            }
+        }
+        let (points, interpolated) =
+            match route::rule(survey.interpolable, points(&plan), accuracy)? {
+                Route::Dense(p) => (p, true),
+                Route::Pointwise(p) => (p, false),
+                other => unreachable!("a stack's rule route: {other:?}"),
+            };
+        let rule = chebyshev::rule(set, points);
+        let prepared = Prepared::structure(&plan.coherence);
+        let mut acc = [[Matrix4::zeros(); 2]; 3];
+        let n = survey.nodes.len();
+        let values: Vec<Vec<C64>> = survey.nodes.iter().map(|b| b.values()).collect();
+        let basis = chebyshev::node_basis(set, points, survey.level);
+        let mut blocks = survey.nodes[n / 2].clone();
+        let mut v = blocks.values();
+        let fixed = if n == 1 {
+            Prepared::new(&blocks, &plan.coherence)
+        } else {
+            Prepared::structure(&plan.coherence)
+        };
+        for (j, (k, w)) in rule.nodes.iter().enumerate() {
+            let m = if n == 1 {
+                // Without dispersion the blocks, and the layers' q, are the same everywhere.
+                coherence::mueller(&blocks, &plan.coherence, &fixed, TAU / k, want)?
+            } else {
+                if interpolated {
+                    v.iter_mut().for_each(|x| *x = C64::new(0.0, 0.0));
+                    for (node, &bi) in values.iter().zip(&basis[j * n..(j + 1) * n]) {
+                        for (x, y) in v.iter_mut().zip(node) {
+                            *x += y * bi;
+                        }
+                    }
+                    blocks.set_values(&v);
+                    layer_q_into(self.stack, TAU / k, &self.frame, self.beta, &mut blocks.q)?;
+                } else {
+                    blocks = self.solve(*k)?;
+                }
+                coherence::mueller(&blocks, &plan.coherence, &prepared, TAU / k, want)?
+            };
+            add_weighted(&mut acc, &m, w, output);
+        }
+        Ok(acc.map(|[r, t]| SlabMueller {
+            r: want.reflection.then_some(r),
+            t: want.transmission.then_some(t),
+        }))
+    }
+}
+
+/// `acc[c][lobe] += w_c M_lobe` over the entries the output needs.
+fn add_weighted(acc: &mut [[Matrix4<f64>; 2]; 3], m: &SlabMueller, w: &[f64; 3], output: Output) {
+    let lobes = [m.r, m.t];
+    for (sums, wc) in acc.iter_mut().zip(w) {
+        for (sum, lobe) in sums.iter_mut().zip(&lobes) {
+            match (lobe, output) {
+                (Some(x), Output::Mueller) => *sum += x * *wc,
+                (Some(x), Output::Intensity) => sum[(0, 0)] += x[(0, 0)] * wc,
+                (None, _) => {}
+            }
+        }
+    }
+}
+
 /// Most stack evaluations of one [`quadrature`].
 pub const QUADRATURE_MAX: usize = 10_000_000;
 
@@ -306,7 +363,7 @@ pub fn quadrature(
 
 /// The fastest oscillation (nm) of the plan whose amplitude `ρⁿ / (1 − ρ)²` after `n` round
 /// trips is at least [`TOLERANCE`] (the direct light's `ω_b` always; at most 64 round trips).
-pub fn fastest(plan: &Plan) -> f64 {
+pub fn fastest(plan: &StackPlan) -> f64 {
     let mut omega = plan.omega_b;
     if !(0.0..1.0).contains(&plan.rho) {
         return omega + 64.0 * plan.omega_1;

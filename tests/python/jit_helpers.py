@@ -80,6 +80,7 @@ def sample(bsdf, ctx, si, u: np.ndarray):
     lanes = lambda x: np.broadcast_to(np.array(x), np.array(x).shape[:-1] + (n,))  # noqa: E731
     with evaluated_mode():
         bs, w = bsdf.sample(ctx, si, floats(u), mi.Point2f(0.5, 0.5))
+        dr.eval(bs, w)  # one kernel for every output (read one by one: a kernel each)
         out = {"wo": lanes(bs.wo).T, "pdf": lanes(bs.pdf), "eta": lanes(bs.eta),
                "component": lanes(bs.sampled_component), "type": lanes(bs.sampled_type)}
         return out, lanes(w)

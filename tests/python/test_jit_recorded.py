@@ -140,6 +140,7 @@ def jit_lanes(variant, desc, mode, wi, uv, waves, u, null):
     if null:
         return lanes_of(bsdf.eval_null_transmission(si))
     bs, w = bsdf.sample(context(mode), si, floats(u), mi.Point2f(0.5, 0.5))
+    dr.eval(bs, w)  # one kernel for every output (read one by one: a kernel each)
     return (lanes_of(bs.wo).T, lanes_of(bs.pdf), lanes_of(bs.eta),
             lanes_of(bs.sampled_component), lanes_of(w))
 

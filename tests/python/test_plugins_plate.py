@@ -271,7 +271,7 @@ def test_energy_of_a_clear_plate_band_integrated(name):
     variant(name)
     p = plate(material="calcite", thickness=7.0, optic_axis=[0.3, 0.5, 0.81], filter_bandwidth=4.0)
     # The band: measured 3.0e-8, float32 rounding, as for the exact plate. The RGB channels are
-    # integrated to a perceptual budget (src/spectral/channels.rs: each approximation held to
+    # integrated to a perceptual budget (src/quadrature/budget.rs: each approximation held to
     # 1e-5 of the light; a few add up in R + T): measured 2.3e-5, bound 1e-4 (a CIEDE2000 below
     # 0.1 on a bright plate).
     bound = 1e-4 if name == "scalar_rgb" else 1e-7

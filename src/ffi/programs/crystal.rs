@@ -10,7 +10,7 @@ use crate::plate::slab::Output as Intensity;
 use crate::real::{Mask, Real};
 use crate::record::{self, Output, Var};
 use crate::render::crystal::{sample_exact, ExactCrystal};
-use crate::render::plate::MAX_BANDS;
+use crate::render::thin::MAX_BANDS;
 use crate::render::Transport;
 use crate::C64;
 use nalgebra::Vector3;
@@ -48,13 +48,22 @@ pub fn record_crystal(materials: &Materials, recipe: &CrystalRecipe) -> Result<B
                 Var::cst(value)
             }
         };
-        // The ordinary or the extraordinary input of a pair.
-        let of = |extraordinary: bool, (o, e)| if extraordinary { e } else { o };
+        // The ordinary or the extraordinary input of a pair. An isotropic crystal stays
+        // isotropic: both indices are the pair's mean (moving one alone would split its
+        // refraction into o and e rays), so each carries half the derivative along the pair.
+        let isotropic = material.is_isotropic();
+        let pair = |extraordinary: bool, (o, e): (CrystalInput, CrystalInput), value, is_input| {
+            if isotropic && is_input {
+                (input(o) + input(e)) * Var::cst(0.5)
+            } else {
+                given(if extraordinary { e } else { o }, value, is_input)
+            }
+        };
         let indices = (CrystalInput::EtaO, CrystalInput::EtaE);
         let kappas = (CrystalInput::KappaO, CrystalInput::KappaE);
         let material = material.lifted(
-            |e, n| given(of(e, indices), n, recipe.indices_are_inputs),
-            |e, kappa| given(of(e, kappas), kappa, recipe.kappas_are_inputs),
+            |e, n| pair(e, indices, n, recipe.indices_are_inputs),
+            |e, kappa| pair(e, kappas, kappa, recipe.kappas_are_inputs),
         );
         let a = recipe.optic_axis;
         let axis = Vector3::new(

@@ -18,7 +18,7 @@ use crate::error::{Error, Result};
 use crate::real::{Mask, Real};
 use crate::record::{self, Op, Output, Var};
 use crate::render::choice::Sampled;
-use crate::render::plate::MAX_BANDS;
+use crate::render::thin::MAX_BANDS;
 use crate::render::Transport as CoreTransport;
 
 /// A recorded program, as the shim reads it.

@@ -11,7 +11,8 @@ use crate::plate::Plate;
 use crate::real::complex::Cx;
 use crate::real::Real;
 use crate::record::{self, Var};
-use crate::render::plate::{sample_exact, ExactPlate, MAX_BANDS};
+use crate::render::plate::{sample_exact, ExactPlate};
+use crate::render::thin::MAX_BANDS;
 use nalgebra::Vector3;
 
 /// Records the sample of a `thinbirefringent` plate over `recipe.channels` exact wavelengths

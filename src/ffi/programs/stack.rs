@@ -11,7 +11,7 @@ use crate::plate::slab::{Output as Intensity, Want};
 use crate::real::complex::Cx;
 use crate::real::{Mask, Real};
 use crate::record::{self, Flag, Output, Var};
-use crate::render::plate::MAX_BANDS;
+use crate::render::thin::MAX_BANDS;
 use crate::render::stack::{sample_exact_stack, ExactStack};
 use crate::render::Transport;
 use crate::stack::{in_layer, Stack};

@@ -1,8 +1,8 @@
 //! One colour channel of a weight set, the unit of a channel render: the plate integrated in
 //! closed form over that channel's weight (docs/physics.md, section 7, "Channel renders").
 
+use super::data;
 use super::weights::{self, white_scale, WeightSet};
-use super::weights_data as data;
 
 /// The name of [`Channel::LUMINANCE`]: the plugins' default `channel` in the mono variants.
 pub const DEFAULT_CHANNEL: &str = "xyz-d65:Y";

@@ -1,15 +1,19 @@
-//! The shared three-channel quadrature (`spectral::shared`, panels sized order by order) against
-//! a dense composite Gauss–Legendre rule of the exact plate (both interfaces solved at every
-//! node, no interpolation, 1024 panels over the same support; the shared rule interpolates on Chebyshev points), Mueller matrices entry by entry.
+//! The exact plate on a weight set's Chebyshev rule (`spectral::pointwise`, its points sized
+//! order by order by `quadrature::chebyshev`) against a dense composite Gauss–Legendre rule of
+//! the exact plate (both interfaces solved at every node, no interpolation, 1024 panels over the
+//! same support; the Chebyshev rule interpolates), Mueller matrices entry by entry.
 
+use birefringent::colour::weights::{gaussians, WeightSet};
 use birefringent::material::Material;
 use birefringent::optics::frame::PlaneFrame;
 use birefringent::plate::slab::Output;
 use birefringent::plate::slab::Want;
 use birefringent::plate::Plate;
-use birefringent::spectral::hermite;
-use birefringent::spectral::shared::{self, support};
-use birefringent::spectral::weights::{gaussians, WeightSet};
+use birefringent::quadrature::chebyshev::support;
+use birefringent::quadrature::hermite;
+use birefringent::spectral::pointwise;
+use birefringent::spectral::route;
+use birefringent::spectral::survey::Survey;
 use birefringent::C64;
 use nalgebra::Matrix4;
 use std::f64::consts::TAU;
@@ -45,7 +49,7 @@ fn dense(plate: &Plate, frame: &PlaneFrame, beta: C64, set: WeightSet) -> [[Matr
 }
 
 #[test]
-fn shared_rule_matches_a_dense_rule_of_the_exact_plate() {
+fn chebyshev_rule_of_the_exact_plate_matches_a_dense_rule() {
     let mut rng = Rng::new(2027);
     let names = ["linbo3", "quartz", "calcite", "sapphire", "mgf2", "rutile"];
     let (mut worst, mut planned, mut declined) = (0.0f64, 0, 0);
@@ -67,13 +71,14 @@ fn shared_rule_matches_a_dense_rule_of_the_exact_plate() {
         let frame = PlaneFrame::from_azimuth(rng.range(0.0, TAU));
         let beta = C64::new(rng.range(0.0, 0.95), 0.0);
         let set = WeightSet::ALL[i % 3];
-        let Some(points) = shared::plan(&plate, &frame, beta, set).unwrap() else {
+        let survey = Survey::new(&plate, frame, beta).unwrap();
+        let Some(points) = route::rule_points(&survey, set) else {
             declined += 1;
             continue;
         };
         planned += 1;
         point_counts.push(points);
-        let got = shared::quadrature(
+        let got = pointwise::channels(
             &plate,
             &frame,
             beta,
@@ -94,7 +99,7 @@ fn shared_rule_matches_a_dense_rule_of_the_exact_plate() {
     }
     point_counts.sort_unstable();
     println!(
-        "shared rule: {planned} plates ({declined} declined), points median {} max {}; worst |dM| vs dense {worst:e}",
+        "Chebyshev rule: {planned} plates ({declined} declined), points median {} max {}; worst |dM| vs dense {worst:e}",
         point_counts[point_counts.len() / 2],
         point_counts.last().unwrap()
     );

@@ -105,7 +105,7 @@ mod tests {
             assert!((c - (-0.5 * a * a).exp()).abs() < 1e-10, "{a}: {c}");
         }
         // The composite rule resolves fast oscillations with two panels per period over ±6.5
-        // (the density `integrate::auto` uses).
+        // (the density `spectral::gaussian::auto` uses).
         for a in [0.5f64, 3.0, 20.0, 60.0] {
             let panels = ((2.0 * 13.0 * a / std::f64::consts::TAU).ceil() as usize).max(16);
             let r = composite_normal(panels);

@@ -211,6 +211,30 @@ pub fn chebyshev_at(c: &[f64], t: f64) -> f64 {
     t * b1 - b2 + c[0]
 }
 
+/// `2 Σ_{m≥n} |c_m|` beyond the `n` known coefficient magnitudes `c`, for a geometric decay
+/// estimated from the last four in pairs (the even and odd parts of a function can decay
+/// differently): with `s = |c_{n−1}| + |c_{n−2}|`, `r = √(s / (|c_{n−3}| + |c_{n−4}|))` per
+/// coefficient (at most 0.9), `2 s r/(1 − r)`.
+pub fn series_tail(c: &[f64]) -> f64 {
+    let n = c.len();
+    if n < 4 {
+        return 0.0;
+    }
+    // The last two coefficients (even and odd parts can decay at different rates) and the
+    // ratio of the last pair to the pair before.
+    let (last, before) = (c[n - 1] + c[n - 2], c[n - 3] + c[n - 4]);
+    if last == 0.0 {
+        return 0.0;
+    }
+    let r = if before > 0.0 {
+        (last / before).sqrt()
+    } else {
+        1.0
+    }
+    .min(0.9);
+    2.0 * last * r / (1.0 - r)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

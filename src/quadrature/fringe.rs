@@ -11,17 +11,21 @@
 //! (Filon's idea, L. N. G. Filon, Proc. R. Soc. Edinb. 49, 1928: interpolate the slow factor,
 //! integrate the oscillation exactly).
 //!
-//! The channel weights are the Gaussian fits of [`crate::spectral::weights`], and the weights
+//! The channel weights are the Gaussian fits of [`crate::colour::weights`], and the weights
 //! are exact for them: for `X ~ N(μ, σ²)` and a polynomial `L`,
 //! `E[L(X) e^{iGX}] = e^{iGμ − σ²G²/2} E[L(μ + iσ²G + σZ)]` (completing the square), and the
 //! expectation is a Gauss–Hermite sum of `⌈n/2⌉` points, exact for degree `n − 1`. `W_ic` is
-//! tabulated in `G` once per weight set and node count and interpolated (cubic, step
-//! [`STEP_NM`]: the error is below 1e-5 of the white response).
+//! tabulated in `G` per weight set and node count and interpolated (cubic, step [`STEP_NM`]: the
+//! error is below 1e-5 of the white response). The table is built where a query first needs
+//! it, [`CHUNK`] rows at a time, each row from the Chebyshev form of the Lagrange basis,
+//! `L_i = Σ_m D_mi T_m` (`D` the nodes' discrete cosine transform), so that a Gaussian's
+//! `E[T_m(c + s Z)]` for every `m` costs one three-term recurrence per Hermite point (no
+//! division); the visibilities are closed forms, `Σ_i W_ic(G) = Σ_j a_j e^{iG(μ_j − k₀) −
+//! σ_j²G²/2}` (the basis sums to 1). A first query pays only for the rows it reads.
 
-use crate::band::Gaussian;
-use crate::spectral::hermite;
-use crate::spectral::nodes::{lagrange, lobatto, LEVELS};
-use crate::spectral::weights::{gaussians, WeightSet};
+use crate::colour::weights::{gaussians, WeightSet};
+use crate::quadrature::hermite;
+use crate::quadrature::nodes::{self, lobatto, LEVELS, MAX_NODES};
 use num_complex::Complex64 as C64;
 use std::f64::consts::TAU;
 use std::sync::OnceLock;
@@ -39,18 +43,61 @@ pub const STEP_NM: f64 = 20.0;
 /// where every Gaussian's `|a| e^{−σ²G²/2}` falls below it.
 pub const NEGLIGIBLE: f64 = 1e-7;
 
+/// Rows of the table built at once.
+pub const CHUNK: usize = 4;
+
 /// The rule of one weight set and node count.
 pub struct FringeRule {
+    set: WeightSet,
     /// Nodes `k_i` (rad/nm), descending (Lobatto order `cos(π i/(n−1))`).
     nodes: Vec<f64>,
-    /// `W_ic(m STEP_NM)` at index `m n + i`, channels last.
-    table: Vec<[C64; 3]>,
+    /// `W_ic(m STEP_NM)` at index `m n + i` of chunk `m / CHUNK`, channels last, built on
+    /// first use.
+    chunks: Vec<OnceLock<Box<[[C64; 3]]>>>,
     /// Entries of the table per node (`G` from 0 to `(rows − 1) STEP_NM`).
     rows: usize,
     /// `max_c |Σ_i W_ic(G)|` (the visibility of a fringe of constant amplitude) per row.
-    visibility: Vec<f64>,
+    visibility: &'static [f64],
     /// The largest visibility at this row or beyond (a bound for every `|G'| ≥ G`).
-    beyond: Vec<f64>,
+    beyond: &'static [f64],
+}
+
+/// The visibility of a constant fringe per table row of `set`, `max_c |Σ_j a_j e^{iG(μ_j − k₀) −
+/// σ_j²G²/2}|` (the basis sums to 1: module docs), and its running maximum from each row on;
+/// computed once per weight set (every level shares them), each Gaussian's factor by a
+/// recurrence over the rows (a phasor and `e^{−σ²S²(2m+1)/2}` per step `S`).
+fn visibilities(set: WeightSet, rows: usize) -> (&'static [f64], &'static [f64]) {
+    type Both = OnceLock<(Vec<f64>, Vec<f64>)>;
+    static ALL: [Both; WeightSet::ALL.len()] = [const { OnceLock::new() }; WeightSet::ALL.len()];
+    let (v, b) = ALL[set.index()].get_or_init(|| {
+        let (k0, _) = band();
+        let mut sums = vec![[C64::new(0.0, 0.0); 3]; rows];
+        for (c, channel) in (0..3).map(|c| (c, gaussians(set, c))) {
+            for g in channel {
+                let turn = C64::from_polar(1.0, STEP_NM * (g.mu - k0));
+                let q = (-(g.sigma * STEP_NM).powi(2)).exp();
+                let (mut term, mut ratio) = (
+                    C64::new(g.amplitude, 0.0),
+                    (-0.5 * (g.sigma * STEP_NM).powi(2)).exp(),
+                );
+                for row in sums.iter_mut() {
+                    row[c] += term;
+                    term *= turn * ratio;
+                    ratio *= q;
+                }
+            }
+        }
+        let visibility: Vec<f64> = sums
+            .iter()
+            .map(|r| r.iter().map(|z| z.norm()).fold(0.0, f64::max))
+            .collect();
+        let mut beyond = visibility.clone();
+        for m in (0..rows.saturating_sub(1)).rev() {
+            beyond[m] = beyond[m].max(beyond[m + 1]);
+        }
+        (visibility, beyond)
+    });
+    (v, b)
 }
 
 /// Centre and half width (rad/nm) of [`BAND_NM`] in wavenumber.
@@ -68,59 +115,84 @@ fn reach(set: WeightSet) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// `W_i(G)` of one Gaussian (channel weight term), added into `acc[i]`.
-fn add_gaussian(g: &Gaussian, x: &[f64], big_g: f64, acc: &mut [C64], scratch: &mut [C64]) {
+/// `Σ_j a_j e^{−σ_j²G²/2} e^{iG(μ_j − k₀)} E[T_m(c_j + s Z)]` for `m < n`, `Z` standard normal,
+/// `c_j = (μ_j − k₀ + iσ_j²G)/a`, `s = σ_j/a` (module docs), over the Gaussians of `channel`
+/// whose envelope is above 1e-3 of [`NEGLIGIBLE`], into `out`.
+fn chebyshev_moments(set: WeightSet, channel: usize, n: usize, big_g: f64, out: &mut [C64]) {
     let (k0, a) = band();
-    let n = x.len();
     let gh = hermite::rule(n.div_ceil(2));
-    let envelope =
-        C64::new(-0.5 * (g.sigma * big_g).powi(2), big_g * (g.mu - k0)).exp() * g.amplitude;
-    let centre = C64::new(g.mu - k0, g.sigma * g.sigma * big_g) / a;
-    for &(z, w) in gh {
-        lagrange(x, centre + g.sigma / a * z, scratch);
-        for (o, l) in acc.iter_mut().zip(&scratch[..n]) {
-            *o += envelope * w * l;
+    out[..n].fill(C64::new(0.0, 0.0));
+    for g in gaussians(set, channel).iter().filter(|g| {
+        g.amplitude.abs() * (-0.5 * (g.sigma * big_g).powi(2)).exp() > 1e-3 * NEGLIGIBLE
+    }) {
+        let envelope =
+            C64::new(-0.5 * (g.sigma * big_g).powi(2), big_g * (g.mu - k0)).exp() * g.amplitude;
+        let centre = C64::new(g.mu - k0, g.sigma * g.sigma * big_g) / a;
+        for &(z, w) in gh {
+            let x = centre + g.sigma / a * z;
+            let weight = envelope * w;
+            // T_0 = 1, T_1 = x, T_{m+1} = 2x T_m − T_{m−1}.
+            let (mut previous, mut current) = (C64::new(1.0, 0.0), x);
+            out[0] += weight;
+            for o in out[1..n].iter_mut() {
+                *o += weight * current;
+                (previous, current) = (current, 2.0 * x * current - previous);
+            }
         }
     }
 }
 
 impl FringeRule {
-    fn build(set: WeightSet, n: usize) -> Self {
+    fn build(set: WeightSet, level: usize) -> Self {
         let (k0, a) = band();
+        let n = LEVELS[level];
         let x = lobatto(n);
         let rows = (reach(set) / STEP_NM).ceil() as usize + 3;
-        let mut table = vec![[C64::new(0.0, 0.0); 3]; rows * n];
-        let mut visibility = vec![0.0; rows];
-        let (mut acc, mut scratch) = (vec![C64::new(0.0, 0.0); n], vec![C64::new(0.0, 0.0); n]);
-        for m in 0..rows {
-            let big_g = m as f64 * STEP_NM;
-            for c in 0..3 {
-                acc.iter_mut().for_each(|v| *v = C64::new(0.0, 0.0));
-                // Terms whose envelope |a| e^{−σ²G²/2} is below 1e-3 of what the table keeps
-                // change no entry.
-                for g in gaussians(set, c).iter().filter(|g| {
-                    g.amplitude.abs() * (-0.5 * (g.sigma * big_g).powi(2)).exp() > 1e-3 * NEGLIGIBLE
-                }) {
-                    add_gaussian(g, &x, big_g, &mut acc, &mut scratch);
-                }
-                for (entry, v) in table[m * n..m * n + n].iter_mut().zip(&acc) {
-                    entry[c] = *v;
-                }
-                let total: C64 = acc.iter().sum();
-                visibility[m] = f64::max(visibility[m], total.norm());
-            }
-        }
-        let mut beyond = visibility.clone();
-        for m in (0..rows.saturating_sub(1)).rev() {
-            beyond[m] = beyond[m].max(beyond[m + 1]);
-        }
+        let (visibility, beyond) = visibilities(set, rows);
         FringeRule {
+            set,
             nodes: x.iter().map(|t| k0 + a * t).collect(),
-            table,
+            chunks: (0..rows.div_ceil(CHUNK)).map(|_| OnceLock::new()).collect(),
             rows,
             visibility,
             beyond,
         }
+    }
+
+    /// Rows `CHUNK chunk ..` of the table: `W_ic(G) = Σ_m D_mi M_mc(G)` with the Gaussians'
+    /// Chebyshev moments `M` ([`chebyshev_moments`]) and the level's transform `D`.
+    fn chunk(&self, chunk: usize) -> &[[C64; 3]] {
+        self.chunks[chunk].get_or_init(|| {
+            let n = self.nodes.len();
+            let level = LEVELS.iter().position(|&l| l == n).expect("a level");
+            let dct = &nodes::level(level).dct;
+            let first = chunk * CHUNK;
+            let last = (first + CHUNK).min(self.rows);
+            let mut table = vec![[C64::new(0.0, 0.0); 3]; (last - first) * n];
+            let mut moments = [C64::new(0.0, 0.0); MAX_NODES];
+            for m in first..last {
+                let big_g = m as f64 * STEP_NM;
+                for c in 0..3 {
+                    chebyshev_moments(self.set, c, n, big_g, &mut moments);
+                    let row = &mut table[(m - first) * n..(m - first + 1) * n];
+                    for (i, entry) in row.iter_mut().enumerate() {
+                        // One node: L_0 = 1 (the transform's end weights halve a single node).
+                        entry[c] = if n == 1 {
+                            moments[0]
+                        } else {
+                            (0..n).map(|k| moments[k] * dct[k][i]).sum()
+                        };
+                    }
+                }
+            }
+            table.into_boxed_slice()
+        })
+    }
+
+    /// Row `m`'s entry of node `i`.
+    fn entry(&self, m: usize, i: usize) -> &[C64; 3] {
+        let n = self.nodes.len();
+        &self.chunk(m / CHUNK)[(m % CHUNK) * n + i]
     }
 
     /// The nodes `k_i` (rad/nm).
@@ -165,7 +237,6 @@ impl FringeRule {
     /// The weights `W_ic(G)` of node `i` (zero beyond [`FringeRule::reach`]): cubic
     /// interpolation between the table's rows.
     pub fn weight(&self, g: f64, i: usize) -> [C64; 3] {
-        let n = self.nodes.len();
         let s = g.abs() / STEP_NM;
         let mut out = [C64::new(0.0, 0.0); 3];
         if s.is_nan() || s >= (self.rows - 2) as f64 {
@@ -186,7 +257,7 @@ impl FringeRule {
                 Some(row) => (row, false),
                 None => (1, true),
             };
-            let w = &self.table[row * n + i];
+            let w = self.entry(row, i);
             for c in 0..3 {
                 out[c] += if flip { w[c].conj() } else { w[c] } * lr;
             }
@@ -204,13 +275,13 @@ pub fn rule(set: WeightSet, level: usize) -> &'static FringeRule {
     static RULES: [[OnceLock<FringeRule>; LEVELS.len()]; SETS] =
         [const { [const { OnceLock::new() }; LEVELS.len()] }; SETS];
     let level = level.min(LEVELS.len() - 1);
-    RULES[set.index()][level].get_or_init(|| FringeRule::build(set, LEVELS[level]))
+    RULES[set.index()][level].get_or_init(|| FringeRule::build(set, level))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::spectral::weights::fit_per_wavenumber;
+    use crate::colour::weights::fit_per_wavenumber;
 
     /// `∫ w_c(k) P(k) e^{iG(k − k₀)} dk` of the Gaussian fit by dense composite Gauss–Legendre
     /// quadrature over every Gaussian's ±9σ (written independently of the rule).

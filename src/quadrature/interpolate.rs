@@ -1,35 +1,23 @@
-//! A dispersive plate's amplitudes across a spectrum, interpolated: the interface blocks, the
-//! layer's normal components and the flux factor ([`SlabBlocks`]) depend on the wavelength only
-//! through the indices, which vary slowly (Sellmeier fits away from their poles), while the
-//! propagation phases `k d q` oscillate. A quadrature of the plate over a wide band needs the
-//! exact plate at hundreds of wavenumbers; solving both interfaces at a few Chebyshev nodes
-//! and interpolating the blocks (a Chebyshev series, e.g. Trefethen, *Approximation Theory and
-//! Approximation Practice*, ch. 3) gives each quadrature node for the cost of the phases.
+//! Values that vary slowly across a spectrum (a plate's or a stack's interface blocks, which
+//! depend on the wavelength only through the indices: Sellmeier fits away from their poles),
+//! interpolated by a checked Chebyshev series (e.g. Trefethen, *Approximation Theory and
+//! Approximation Practice*, ch. 3), so that a quadrature over a wide band pays for the exact
+//! solves only at a few nodes and for the phases at every point.
 //!
-//! The interpolant is accepted only if it reproduces the exact blocks at check points between
-//! the nodes to [`TOLERANCE`] (relative to the largest value). [`NODES`] Chebyshev nodes serve
-//! most crystals across the visible; strongly dispersive ones (rutile, whose coefficients decay
-//! only ~3x per degree near its UV absorption) are tried again with [`MORE_NODES`]. Otherwise (a
-//! critical angle or a degenerate mode inside the band, where the blocks are not smooth) the
-//! caller solves every node exactly.
-//!
-//! [`Interpolant`] is the same series for any vector of values (a stack's `N + 1` interfaces,
-//! [`crate::stack::spectral`]), with the caller's tolerance.
+//! The interpolant is accepted only if it reproduces the exact values at check points between
+//! the nodes to the caller's tolerance (relative to the largest value). [`NODES`] Chebyshev
+//! nodes serve most crystals across the visible; strongly dispersive ones (rutile, whose
+//! coefficients decay only ~3x per degree near its UV absorption) are tried again with
+//! [`MORE_NODES`]. Otherwise (a critical angle or a degenerate mode inside the band, where the
+//! values are not smooth) the caller solves every point exactly.
 
 use crate::error::Result;
-use crate::plate::slab::{SlabBlocks, BLOCK_VALUES};
 use num_complex::Complex64 as C64;
 
 /// Chebyshev nodes of the interpolant.
 pub const NODES: usize = 16;
 /// Chebyshev nodes of the second attempt.
 pub const MORE_NODES: usize = 32;
-/// Largest accepted interpolation error of a plate's blocks at the check points, relative to
-/// the largest value.
-pub const TOLERANCE: f64 = 1e-10;
-/// Trailing coefficients of a plate's blocks are dropped while their sum stays below this,
-/// relative to the largest value.
-const TRUNCATION: f64 = 0.1 * TOLERANCE;
 /// Where the interpolant is checked, in `[−1, 1]` (between nodes, ends included).
 const CHECKS: [f64; 4] = [-0.999, -0.61, 0.17, 0.93];
 
@@ -147,39 +135,5 @@ impl Interpolant {
             }
             (previous, current) = (current, 2.0 * t * current - previous);
         }
-    }
-}
-
-/// A plate's blocks ([`SlabBlocks::values`]) interpolated by an [`Interpolant`].
-pub struct BlockInterpolant {
-    values: Interpolant,
-    thickness_nm: f64,
-}
-
-impl BlockInterpolant {
-    /// Interpolates `exact(k)` on `[lo, hi]` to [`TOLERANCE`] ([`Interpolant::new`]);
-    /// `Ok(None)` if it cannot.
-    pub fn new(
-        lo: f64,
-        hi: f64,
-        thickness_nm: f64,
-        exact: &dyn Fn(f64) -> Result<SlabBlocks>,
-    ) -> Result<Option<Self>> {
-        let values = |k: f64| exact(k).map(|b| b.values().to_vec());
-        Ok(
-            Interpolant::new((lo, hi), (TOLERANCE, TRUNCATION), &values)?.map(|values| {
-                BlockInterpolant {
-                    values,
-                    thickness_nm,
-                }
-            }),
-        )
-    }
-
-    /// The interpolated blocks at wavenumber `k` (inside `[lo, hi]`).
-    pub fn at(&self, k: f64) -> SlabBlocks {
-        let mut v = [C64::new(0.0, 0.0); BLOCK_VALUES];
-        self.values.at_into(k, &mut v);
-        SlabBlocks::from_values(&v, self.thickness_nm)
     }
 }

@@ -44,7 +44,7 @@ pub fn interpolation_error(n: usize, omega: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::spectral::nodes::{lobatto, LEVELS};
+    use crate::quadrature::nodes::{lobatto, LEVELS};
     use num_complex::Complex64 as C64;
 
     /// The bound holds for the actual interpolant of `e^{iωt}` on each level's nodes, measured
@@ -59,7 +59,7 @@ mod tests {
                 let mut worst = 0.0f64;
                 for s in 0..=400 {
                     let t = -1.0 + 2.0 * s as f64 / 400.0;
-                    crate::spectral::nodes::lagrange(&x, C64::new(t, 0.0), &mut basis);
+                    crate::quadrature::nodes::lagrange(&x, C64::new(t, 0.0), &mut basis);
                     let p: C64 = x.iter().zip(&basis).map(|(&xi, b)| f(xi) * b).sum();
                     worst = worst.max((p - f(t)).norm());
                 }
