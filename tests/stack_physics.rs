@@ -479,8 +479,8 @@ fn lyot_filter_passbands_follow_the_closed_form() {
 #[test]
 fn a_stack_seen_from_below_mirrors_its_layers() {
     use birefringent::render::plate::{plate_lobes, PlateQuery};
-    use birefringent::render::thin::Spectrum;
     use birefringent::render::stack::{stack_lobes, StackQuery};
+    use birefringent::render::thin::Spectrum;
     use birefringent::render::Transport;
     use nalgebra::{Matrix4, Vector4};
 

@@ -41,9 +41,10 @@ def plugin_message(error: BaseException | None) -> str | None:
 
 
 def cuda_refusal(variant: str, supported: tuple[str, ...]) -> str:
-    """The plugins' refusal of a CUDA variant (the text of cpp/src/plugins.h's)."""
-    return (f'variant "{variant}" is not supported by {listed()} (their core computes on the '
-            f'CPU); use "llvm{variant[4:]}", or any of ' + ", ".join(supported))
+    """What the plugins say where `mi.set_variant` of a CUDA variant fails: no CUDA device."""
+    return (f'variant "{variant}" needs a CUDA device and Dr.Jit found none on this machine; '
+            f'{listed()} render in it on a machine with an NVIDIA GPU; here use '
+            f'"llvm{variant[4:]}", or any of ' + ", ".join(v for v in supported if not v.startswith("cuda_")))
 
 
 def wrap_render(render: Callable[..., Any]) -> Callable[..., Any]:

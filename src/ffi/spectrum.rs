@@ -116,7 +116,7 @@ impl PlateSpectrum {
     pub fn gradients_refused(&self) -> String {
         let instead = "render gradients in llvm_ad_spectral or llvm_ad_spectral_polarized with filter_bandwidth 0, where the plate is exact at each sampled wavelength";
         match *self {
-            PlateSpectrum::Bands { fwhm_nm } if fwhm_nm == 0.0 => String::new(),
+            PlateSpectrum::Bands { fwhm_nm: 0.0 } => String::new(),
             PlateSpectrum::Bands { fwhm_nm } => format!("filter_bandwidth: gradients of a plate averaged over a band ({fwhm_nm} nm) are not available: set filter_bandwidth to 0 ({instead})"),
             PlateSpectrum::Srgb => format!("variant: gradients of a plate integrated over the sRGB channels (llvm_ad_rgb) are not available: {instead}"),
             PlateSpectrum::Channel(c) => format!("variant: gradients of a plate integrated over the colour channel \"{}\" (llvm_ad_mono, llvm_ad_mono_polarized) are not available: {instead}", c.name()),

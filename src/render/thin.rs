@@ -10,7 +10,6 @@
 //! ([`Thin::oriented`], [`Element::flipped`]: exterior and exit swapped, mirrored through `z = 0`), solved as if from
 //! above, its matrices mirrored back (`D M D`, `D = diag(1, 1, −1, −1)`).
 
-
 use crate::band::{is_exact_band, narrow_band};
 use crate::colour::weights::WeightSet;
 use crate::error::{Error, Result};
@@ -192,9 +191,6 @@ pub fn evaluate<M: ThinModel>(
     }
 }
 
-/// The element's lobes seen from `wi`, one `[reflection, transmission]` pair per spectral
-/// channel (module docs). `share`: one solve for both lobes (else each lobe solved on its own,
-
 /// A host query is the thin element over `f64`: its spectrum a [`Spectrum`], evaluated through
 /// the element's model ([`evaluate`]).
 impl<E: Element> Thin for ThinQuery<E> {
@@ -248,7 +244,12 @@ impl<E: Element> Thin for ThinQuery<E> {
         beta: C64,
         want: Want,
     ) -> Result<Vec<SlabMueller>> {
-        evaluate(&self.element.model(frame, beta), spectrum, want, self.output)
+        evaluate(
+            &self.element.model(frame, beta),
+            spectrum,
+            want,
+            self.output,
+        )
     }
 }
 

@@ -5,8 +5,8 @@
 use birefringent::ffi::bridge::SampleOutput;
 use birefringent::render::choice::{choose, Sampled};
 use birefringent::render::plate::sample_exact;
-use birefringent::render::thin::{Spectrum, MAX_BANDS};
 use birefringent::render::thin::Thin;
+use birefringent::render::thin::{Spectrum, MAX_BANDS};
 use birefringent::render::{PathLobe, Transport};
 use nalgebra::Vector3;
 use std::fmt::Debug;

@@ -129,8 +129,8 @@ MISTAKES = [
                                      "drjit.JitFlag.SymbolicCalls",
                                      "mitsuba_birefringent.evaluated_mode()")),
     Mistake("cuda_variant",
-            "cuda variants are the fast ones of Mitsuba's wheel; the core computes on the CPU",
-            "cuda", {}, ('variant "cuda_ad_rgb" is not supported', 'use "llvm_ad_rgb"')),
+            "cuda variants are the fast ones of Mitsuba's wheel; this machine has no CUDA device",
+            "cuda", {}, ('variant "cuda_ad_rgb" needs a CUDA device', 'use "llvm_ad_rgb"')),
     Mistake("calculator_thickness_without_unit",
             "the plugin's parameter is `thickness`; the calculator's carries its unit",
             "calculator", {}, ("thickness: unknown field", "did you mean thickness_um")),
@@ -297,7 +297,7 @@ def test_the_cli_refuses_a_cuda_variant_with_the_plugins_message(tmp_path):
                         str(xml)], capture_output=True, text=True, timeout=300)
     assert r.returncode == 1
     line = last_line(r.stderr)
-    assert line.startswith('mitsuba-birefringent: error: variant "cuda_ad_rgb" is not supported')
+    assert line.startswith('mitsuba-birefringent: error: variant "cuda_ad_rgb" needs a CUDA device')
     assert 'use "llvm_ad_rgb"' in line, r.stderr
 
 
