@@ -27,15 +27,20 @@ Scenes (llvm_ad_spectral_polarized unless said otherwise):
 
 Measurements, each configuration in processes of its own:
 
-1. **Time** (one process per variant and scene): ours and Mitsuba's loaded, each rendered once
-   (compilation), then ``repeats`` interleaved rounds with fresh seeds; the median wall times and
-   their ratio ours / Mitsuba's.
-2. **First render** (one process per configuration, twice): load and first render with Dr.Jit's
-   kernel cache empty (a fresh ``HOME``, where Dr.Jit keeps it), then again in a new process
-   with that cache warm; the number of kernels compiled and their compile time.
-3. **Peak memory** (the same processes): after the first render, the peak resident set of two
-   more renders (``VmHWM`` reset through ``/proc/self/clear_refs``) over the resident set before
-   them.
+1. **First render** (one process per configuration): load and first render with Dr.Jit's
+   kernel cache empty (a fresh ``HOME``, where Dr.Jit keeps it); the number of kernels compiled
+   and their compile time.
+2. **Time** (processes of their own, kernel cache warm): ``PAIRS`` pairs of processes, ours then
+   Mitsuba's, each loading its scene, rendering it once and then ``repeats`` times with fresh
+   seeds; per process the median render time, per configuration the median over its processes,
+   and their ratio ours / Mitsuba's. Separate processes, because in one process Mitsuba's
+   symbolic calls trace every registered BSDF instance: a scene of Mitsuba's rendered while one
+   of ours exists compiles and carries our program in its kernels too (measured as
+   ``theirs_beside_ours``: Mitsuba's scene interleaved with ours in one process, its median
+   over its median alone).
+3. **Peak memory** (the first-render processes): the peak resident set of the process
+   (``VmHWM``, compilation included) over its resident set after loading the scene, before the
+   first render.
 
 Writes ``bench/out/kernels.json`` and ``bench/out/kernels.png`` and prints the tables with the
 machine's load. Timings on a shared machine move with its load: compare ratios of one run.
@@ -57,6 +62,8 @@ import time
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 RESULT = "\nbench-kernels result: "
 REPEATS = 5
+#: Pairs of timing processes (ours, Mitsuba's) per row.
+PAIRS = 3
 POLARIZED = "llvm_ad_spectral_polarized"
 #: (scene, variant, goal of the ratio ours / Mitsuba's) of the issue that made the kernel path.
 ROWS = [("six_plates", POLARIZED, 2.0), ("bouncing_calcite", POLARIZED, 2.0),
@@ -165,21 +172,18 @@ def child_alone(scene: str, variant: str, who: str, repeats: int) -> dict:
     dr.set_flag(dr.JitFlag.KernelHistory, True)
     start = time.perf_counter()
     s = mi.load_dict(scene_dict(mi, scene, who == "ours"))
-    first = render(mi, s, 0, evaluated) + 0.0
+    loaded = status_kib("VmRSS")
+    first = render(mi, s, 0, evaluated)
     first_with_load = time.perf_counter() - start
     history = [k for k in dr.kernel_history() if k.get("type") == dr.KernelType.JIT]
     compiled = [k for k in history if not k.get("cache_hit")]
     compile_ms = sum(k.get("codegen_time", 0.0) + k.get("backend_time", 0.0) for k in compiled)
     dr.set_flag(dr.JitFlag.KernelHistory, False)
     times = [render(mi, s, r + 1, evaluated) for r in range(repeats)]
-    before = status_kib("VmRSS")
-    pathlib.Path("/proc/self/clear_refs").write_text("5")
-    for r in range(2):
-        render(mi, s, 100 + r, evaluated)
     peak = status_kib("VmHWM")
     return {"first_render_s": first, "first_with_load_s": first_with_load,
             "kernels": len(history), "compiled": len(compiled), "compile_ms": compile_ms,
-            "median_s": statistics.median(times), "render_peak_mib": max(0, peak - before) / 1024,
+            "median_s": statistics.median(times), "render_peak_mib": max(0, peak - loaded) / 1024,
             "evaluated_mode": evaluated}
 
 
@@ -191,13 +195,23 @@ def run_child(args: list[str], env: dict | None = None):
     return json.loads(out.stdout.split(RESULT)[-1])
 
 
-def alone_cold_and_warm(scene: str, variant: str, who: str, repeats: int) -> dict:
-    """child_alone with Dr.Jit's kernel cache empty (a fresh HOME), then warm (the same HOME)."""
+def measure_row(scene: str, variant: str, repeats: int) -> dict:
+    """Per configuration a process with Dr.Jit's kernel cache empty (a fresh HOME), then PAIRS
+    alternating pairs of processes with it warm (the same HOME), and (kernel path only) one
+    process rendering both interleaved."""
     with tempfile.TemporaryDirectory() as home:
         env = {**os.environ, "HOME": home}
-        cold = run_child(["alone", scene, variant, who, str(repeats)], env)
-        warm = run_child(["alone", scene, variant, who, str(repeats)], env)
-    return {"cold": cold, "warm": warm}
+        run = lambda who: run_child(["alone", scene, variant, who, str(repeats)], env)  # noqa: E731
+        row = {who: {"cold": run(who), "warm": []} for who in ("ours", "theirs")}
+        for _ in range(PAIRS):
+            for who in ("ours", "theirs"):
+                row[who]["warm"].append(run(who))
+        if not host_path(variant):
+            row["interleaved"] = run_child(["time", scene, variant, str(repeats)], env)
+    for who in ("ours", "theirs"):
+        row[who]["median_s"] = statistics.median(w["median_s"] for w in row[who]["warm"])
+        row[who]["first_warm_s"] = statistics.median(w["first_with_load_s"] for w in row[who]["warm"])
+    return row
 
 
 def plot(rows: list[dict], path: pathlib.Path) -> None:
@@ -220,7 +234,7 @@ def plot(rows: list[dict], path: pathlib.Path) -> None:
         axes[2].bar([k + (i - 0.5) * w for k in x], [r[who]["cold"]["render_peak_mib"] for r in rows],
                     w, label=who)
     axes[1].set_title("first render with load, kernel cache empty (s)")
-    axes[2].set_title("peak memory of a render (MiB)")
+    axes[2].set_title("peak memory over the loaded scene (MiB)")
     for ax in axes:
         ax.set_xticks(list(x), labels, fontsize=8)
     axes[1].legend()
@@ -253,17 +267,13 @@ def main() -> int:
     start = time.perf_counter()
     rows = []
     for scene, variant, goal in rows_wanted:
-        row = {"scene": scene, "variant": variant, "goal": goal}
-        row["ours"] = alone_cold_and_warm(scene, variant, "ours", a.repeats)
-        row["theirs"] = alone_cold_and_warm(scene, variant, "theirs", a.repeats)
-        if host_path(variant):
-            row["interleaved"] = False
-            row["time_ratio"] = row["ours"]["warm"]["median_s"] / row["theirs"]["warm"]["median_s"]
-        else:
-            t = run_child(["time", scene, variant, str(a.repeats)])
-            row["interleaved"], row["times"] = True, t
-            row["time_ratio"] = statistics.median(t["ours"]) / statistics.median(t["theirs"])
-        row["memory_ratio"] = row["ours"]["cold"]["render_peak_mib"] / max(row["theirs"]["cold"]["render_peak_mib"], 1e-9)
+        row = {"scene": scene, "variant": variant, "goal": goal, **measure_row(scene, variant, a.repeats)}
+        row["time_ratio"] = row["ours"]["median_s"] / row["theirs"]["median_s"]
+        if "interleaved" in row:
+            row["theirs_beside_ours"] = (statistics.median(row["interleaved"]["theirs"])
+                                         / row["theirs"]["median_s"])
+        row["memory_ratio"] = (row["ours"]["cold"]["render_peak_mib"]
+                               / max(row["theirs"]["cold"]["render_peak_mib"], 1e-9))
         rows.append(row)
         print(f"{scene:18s} {variant:28s} time ratio {row['time_ratio']:.2f} (goal {goal})", flush=True)
     load_after = os.getloadavg()
@@ -277,17 +287,21 @@ def main() -> int:
     print(f"\nload {load_before[0]:.1f} -> {load_after[0]:.1f} on {os.cpu_count()} cpus; "
           f"{result['seconds']:.0f} s")
     print(f"{'scene':18s} {'variant':28s} {'ratio':>6s} {'goal':>5s} {'ours s':>7s} {'theirs s':>8s} "
-          f"{'1st cold':>9s} {'1st warm':>9s} {'theirs 1st':>10s} {'MiB':>6s} {'theirs':>6s}")
+          f"{'1st cold':>9s} {'1st warm':>9s} {'theirs':>7s} {'compile':>8s} {'MiB':>6s} {'theirs':>6s} "
+          f"{'beside':>7s}")
     for r in rows:
         o, t = r["ours"], r["theirs"]
         print(f"{r['scene']:18s} {r['variant']:28s} {r['time_ratio']:6.2f} {r['goal']:5.1f} "
-              f"{o['warm']['median_s']:7.3f} {t['warm']['median_s']:8.3f} "
-              f"{o['cold']['first_with_load_s']:9.2f} {o['warm']['first_with_load_s']:9.2f} "
-              f"{t['cold']['first_with_load_s']:10.2f} {o['cold']['render_peak_mib']:6.0f} "
-              f"{t['cold']['render_peak_mib']:6.0f}")
-    print("(ratio: median render time ours / Mitsuba's, interleaved in one process except where "
-          "ours needs evaluated mode; 1st: load + first render, Dr.Jit's kernel cache cold / warm; "
-          "MiB: peak resident set of two renders over the process's before them)")
+              f"{o['median_s']:7.3f} {t['median_s']:8.3f} "
+              f"{o['cold']['first_with_load_s']:9.2f} {o['first_warm_s']:9.2f} "
+              f"{t['cold']['first_with_load_s']:7.2f} {o['cold']['compile_ms'] / 1e3:8.2f} "
+              f"{o['cold']['render_peak_mib']:6.0f} {t['cold']['render_peak_mib']:6.0f} "
+              f"{r.get('theirs_beside_ours', float('nan')):7.2f}")
+    print("(ratio: median render time ours / Mitsuba's, each in processes of its own; 1st: load + "
+          "first render, Dr.Jit's kernel cache cold / warm, theirs cold; compile: our kernels' "
+          "compile time, cold (s); MiB: the process's peak resident set over its resident set "
+          "after loading the scene; beside: Mitsuba's render time in a process that also holds "
+          "ours, over alone)")
     return 0
 
 

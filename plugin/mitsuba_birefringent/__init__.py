@@ -10,9 +10,10 @@ Importing the package registers the plugins with Mitsuba's plugin manager::
     plate = mi.load_dict({"type": "thinbirefringent", "material": "quartz", "thickness": 20.0,
                           "optic_axis": [1, 1, 0]})
 
-They work in the variants listed in :data:`VARIANTS` (a cuda variant is refused with the llvm
-variant to use: at scene load, or by ``mi.set_variant`` on a machine without a CUDA device); in
-the llvm variants, render inside :func:`evaluated_mode` (see its module, ``jit``). Importing the
+They work in the variants listed in :data:`VARIANTS`; in the JIT variants their physics runs
+inside Mitsuba's kernels in its default mode, except a plate or stack integrated over colour
+channels or a band, which needs :func:`evaluated_mode` (see its module, ``jit``) and is refused
+in the cuda variants. Importing the
 package also makes ``mi.render`` and ``mi.set_variant`` end with the plugins' own message where
 Dr.Jit would hide it (:mod:`.messages`). The optics is computed by the Rust core linked into the plugin library; see
 ``plugin/README.md`` for the parameters. XML scenes render with the command

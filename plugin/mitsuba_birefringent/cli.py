@@ -14,8 +14,9 @@ extension: ``.exr`` the film (every channel), ``.hdr`` or ``.pfm`` its RGB (or l
 channels in floating point, ``.png``, ``.jpg`` or ``.jpeg`` those in 8-bit sRGB (clamped to
 [0, 1], as ``mi.util.convert_to_bitmap`` writes them); another extension is refused before the
 render. One option is added: ``--spp N`` overrides the sampler's sample count. ``-V`` (the LLVM
-vector width) is not supported. In the llvm variants scenes render in Dr.Jit's evaluated mode, which the plugins
-need (``mitsuba_birefringent.evaluated_mode``).
+vector width) is not supported. In the JIT variants scenes render in Mitsuba's default mode; where a plate or
+stack is integrated over colour channels or a band (its core query runs on the host), the render is done again
+in Dr.Jit's evaluated mode, which that query needs (``mitsuba_birefringent.evaluated_mode``).
 """
 
 from __future__ import annotations
@@ -29,6 +30,7 @@ import drjit as dr
 import mitsuba as mi
 
 import mitsuba_birefringent
+from mitsuba_birefringent.jit import EVALUATED_ONLY
 from mitsuba_birefringent.names import listed
 
 #: Dr.Jit flags that mitsuba's `-O <level>` switches on successively (off above the level).
@@ -131,10 +133,19 @@ def render_file(path: Path, params: dict[str, str], args: argparse.Namespace) ->
     integrator = scene.integrator()
     if integrator is None:
         raise ValueError(f"{path}: the scene has no integrator")
-    # The plugins need Dr.Jit's evaluated mode in the JIT variants (no-op in scalar ones).
-    with thread_count(args.threads), mitsuba_birefringent.evaluated_mode():
+    def render() -> None:
         integrator.render(scene, sensor=args.sensor, seed=0, spp=args.spp or 0, develop=False,
                           evaluate=True)
+
+    with thread_count(args.threads):
+        try:
+            render()  # Mitsuba's default mode: the plugins' physics inside its kernels
+        except RuntimeError as e:
+            if EVALUATED_ONLY not in str(e):
+                raise
+            # A plate or stack over colour channels or a band: its query runs on the host.
+            with mitsuba_birefringent.evaluated_mode():
+                render()
     film = sensors[args.sensor].film()
     if args.output is None:
         film.write(str(path))  # the film's own format, next to the scene (as `mitsuba`)
