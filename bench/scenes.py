@@ -832,10 +832,12 @@ def overhead_room(mi, name: str, variant: str) -> dict:
 
 def evaluated(variant: str) -> bool:
     """Whether the timed rounds of `variant` render in Dr.Jit's evaluated mode: in the llvm
-    variants, ours because they need it, and Mitsuba's plugins too, since while a scene of ours
+    variants where our plates query the host (colour channels: llvm_ad_rgb, the mono passes),
+    ours because they need it, and Mitsuba's plugins too, since while such a scene of ours
     exists in the process a symbolic render of any scene fails (plugin/mitsuba_birefringent/jit.py);
-    Mitsuba's default, symbolic mode is timed after ours are deleted (`symbolic_factor`)."""
-    return variant.startswith("llvm_")
+    Mitsuba's default, symbolic mode is timed after ours are deleted (`symbolic_factor`). In the
+    spectral llvm variants every plugin runs inside Mitsuba's kernels: all in default mode."""
+    return variant.startswith("llvm_") and "_spectral" not in variant
 
 
 def render_in_mode(mi, scene, spp: int, seed: int, evaluated_mode: bool) -> float:

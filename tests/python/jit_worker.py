@@ -88,10 +88,12 @@ def memory(renders: int, leak: bool) -> dict:
 
 
 def symbolic() -> dict:
-    """What the documentation says of symbolic mode: our plugin fails in it with a message
-    naming the flags; while one of its instances lives, a symbolic render of another scene (a
+    """What the documentation says of symbolic mode (Mitsuba's default). A scene whose plugins
+    run inside the kernels (an exact plate and a calcite sphere) renders in it, and so does
+    another scene while it lives. A plate over a band (its query runs on the host) fails in it
+    with a message naming the flags; while it lives, a symbolic render of another scene (a
     dielectric, no plugin of ours) fails too; deleted and collected, that render works."""
-    from robustness_worker import scene_dict
+    from robustness_worker import PLATE, scene_dict
 
     import mitsuba_birefringent
 
@@ -105,14 +107,19 @@ def symbolic() -> dict:
             return str(e.__cause__ or e)
 
     out = {}
-    ours = scene(spp=2, size=(8, 8))
-    out["ours_symbolic"] = attempt(ours)
+    kernel = scene(spp=2, size=(8, 8))
+    out["kernel_symbolic"] = attempt(kernel)
     other = mi.load_dict(scene_dict({"type": "dielectric"}, spp=2, crystal=None, size=(8, 8)))
+    out["other_with_kernel_alive"] = attempt(other)
+    del kernel
+    host = mi.load_dict(scene_dict({**PLATE, "filter_bandwidth": 4.0}, spp=2, crystal=None,
+                                   size=(8, 8)))
+    out["ours_symbolic"] = attempt(host)
     out["other_with_ours_alive"] = attempt(other)
     with mitsuba_birefringent.evaluated_mode():
         out["other_in_evaluated_mode"] = float(np.array(mi.render(other, seed=0)).mean())
     out["flags_restored"] = [bool(dr.flag(f)) for f in mitsuba_birefringent.jit.FLAGS]
-    del ours
+    del host
     gc.collect()
     out["other_after_delete"] = float(np.array(mi.render(other, seed=0)).mean())
     return out

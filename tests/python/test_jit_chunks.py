@@ -4,11 +4,12 @@ answers each lane gets alone. test_jit_batch.py compares smaller batches (one ch
 call of a BSDF pointer array reaches four instances, as a wavefront reaches a scene's BSDFs
 (Mitsuba hands each instance its own lanes, compacted: their order and count differ from the
 wavefront's). The lanes mix directions on both sides, lobe numbers, wavelengths and materials:
-a textured plate of constant indices and a bulk calcite surface with its axis in world space
-(an isotropic one in the unpolarized variants), ~1100 lanes each, so two chunks each; a quartz
-plate and a calcite Null plate, fewer lanes (a channel integration of a dispersive crystal
+a textured plate of constant indices and a sapphire plate on an absorbing exit, ~1100 lanes
+each, so two chunks each; a quartz plate and a calcite Null plate, fewer lanes (a channel integration of a dispersive crystal
 costs milliseconds a lane); in the mono variants each instance renders another channel of
-another weight set (the passes of channel renders).
+another weight set (the passes of channel renders). These are the plugins' host queries (in the
+spectral variants over a band of 4 nm: at exact wavelengths, and a crystal surface in every
+JIT variant, they run inside the kernel, compared lane for lane by test_jit_recorded.py).
 
 Each lane is compared bit for bit (float32 outputs: the same core queries and conversions) with
 the same lane queried alone: in the scalar variant of the same spectrum type, or, for the mono
@@ -57,12 +58,11 @@ def instances(mono: bool) -> list[dict]:
          "thickness": checker(0.3, 0.9), "birefringence": checker(0.0, 0.004),
          "axis_angle": checker(10.0, 70.0), "ext_ior": 1.0, "exit_ior": 1.33, **spectral},
         {"type": "thinbirefringent", "material": "quartz", "optic_axis": [0.2, 1, 0.5],
-         "thickness": 2.0, "axis_angle": 25.0, "ext_ior": 1.2, "exit_ior": 1.0},
+         "thickness": 2.0, "axis_angle": 25.0, "ext_ior": 1.2, "exit_ior": 1.0, **spectral},
         {"type": "thinbirefringent", "material": "calcite", "optic_axis": [0, 0.4, 1],
-         "thickness": 0.5, "ext_ior": 1.0, "exit_ior": 1.0},
-        {"type": "birefringent", "material": "calcite", "optic_axis": [0.3, 0.5, 0.8],
-         "optic_axis_space": "world"} if mi.is_polarized else
-        {"type": "birefringent", "eta_o": 1.6, "eta_e": 1.6, "ext_ior": 1.1},
+         "thickness": 0.5, "ext_ior": 1.0, "exit_ior": 1.0, **spectral},
+        {"type": "thinbirefringent", "material": "sapphire", "optic_axis": [0.3, 0.5, 0.8],
+         "thickness": 1.5, "ext_ior": 1.0, "absorbing_exit": True, **spectral},
     ]
     if mono:
         out = [{**d, "channel": c} for d, c in zip(out, CHANNELS)]

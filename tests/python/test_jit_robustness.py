@@ -54,7 +54,7 @@ def test_invalid_parameters_fail_as_in_the_scalar_variant(params, name):
 
 def test_traversal_and_updates_as_in_the_scalar_variant():
     """The same parameter names; after `thickness_scale` is updated the answer of a lane equals
-    the scalar variant's after the same update (bit for bit, as test_jit_batch.py)."""
+    the scalar variant's after the same update."""
     wi = np.array([[0.3, 0.2, 0.9327379]], dtype=np.float32)
     answers, keys = {}, {}
     for v in (JIT, "scalar_spectral_polarized"):
@@ -77,11 +77,18 @@ def test_traversal_and_updates_as_in_the_scalar_variant():
             answers[v] = np.array(plate.sample(context(), si, 0.7, mi.Point2f(0.5, 0.5))[1],
                                   dtype=np.float32)
     assert keys[JIT] == keys["scalar_spectral_polarized"]
-    assert np.array_equal(answers[JIT], answers["scalar_spectral_polarized"])
+    # The JIT variant replays the core's program in the kernel: equal within float precision
+    # (test_jit_recorded.py's TOL, 4e-6 of the largest entry).
+    want = answers["scalar_spectral_polarized"]
+    assert np.abs(answers[JIT] - want).max() <= 4e-6 * np.abs(want).max()
 
 
 def test_symbolic_mode_fails_clearly_and_a_live_instance_breaks_other_symbolic_renders():
+    """Plugins inside the kernels render in Mitsuba's default mode beside any other scene; a
+    host query (a plate over a band) fails there clearly, with the documented caveat."""
     r = run_worker("symbolic")
+    assert r["kernel_symbolic"] == "rendered", r["kernel_symbolic"]
+    assert r["other_with_kernel_alive"] == "rendered", r["other_with_kernel_alive"]
     message = r["ours_symbolic"]
     for text in ("drjit.JitFlag.SymbolicLoops", "drjit.JitFlag.SymbolicCalls",
                  "mitsuba_birefringent.evaluated_mode()"):
