@@ -30,6 +30,9 @@
 //!
 //! **The points and their weights** depend only on the weight set and the number of points:
 //! they are computed once per (set, rung of [`LADDER`]) and kept, with the rule's error table.
+//! What a first query would otherwise spend most of its time building (the weights' moments, the
+//! error tables, the rules from 256 points) is computed ahead, stored in `chebyshev_tables.bin`
+//! and checked against a fresh computation by a unit test ([`tabulate`]).
 
 use crate::band::Gaussian;
 use crate::colour::weights::{gaussians, WeightSet};
@@ -101,7 +104,8 @@ impl Rule {
 /// The largest error of the rule of `set` with `points` points (rounded up to a rung of
 /// [`LADDER`]) on any oscillation `e^{iω'k}` with `|ω'| ≤ omega` (on a grid of [`FREQUENCIES`]
 /// up to [`PHASE_PER_POINT`] radians per point; 1 beyond), of any channel, from a table per rung
-/// built on first use without the rule itself. The rule integrates the polynomials of degree
+/// computed without the rule itself (stored for the rungs up to 256 points, built on first
+/// use above). The rule integrates the polynomials of degree
 /// `< n` exactly; with `k = c + h t` and `e^{ixt} = Σ_m ε_m i^m J_m(x) T_m(t)` (`x = ωh`) its
 /// error is `|Σ_{m≥n} ε_m i^m J_m(x) (μ̃_m − μ_m)|`, `μ_m` the weight's Chebyshev moments and
 /// `μ̃_m` the rule's, which on the `n` Chebyshev points are `±μ_r` for the alias `r < n` of `m`
