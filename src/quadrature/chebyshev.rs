@@ -30,6 +30,9 @@
 //!
 //! **The points and their weights** depend only on the weight set and the number of points:
 //! they are computed once per (set, rung of [`LADDER`]) and kept, with the rule's error table.
+//! What a first query would otherwise spend most of its time building (the weights' moments, the
+//! error tables, the rules from 256 points) is computed ahead, stored in `chebyshev_tables.bin`
+//! and checked against a fresh computation by a unit test ([`tabulate`]).
 
 use crate::band::Gaussian;
 use crate::colour::weights::{gaussians, WeightSet};
@@ -101,7 +104,8 @@ impl Rule {
 /// The largest error of the rule of `set` with `points` points (rounded up to a rung of
 /// [`LADDER`]) on any oscillation `e^{iω'k}` with `|ω'| ≤ omega` (on a grid of [`FREQUENCIES`]
 /// up to [`PHASE_PER_POINT`] radians per point; 1 beyond), of any channel, from a table per rung
-/// built on first use without the rule itself. The rule integrates the polynomials of degree
+/// computed without the rule itself (stored for the rungs up to 256 points, built on first
+/// use above). The rule integrates the polynomials of degree
 /// `< n` exactly; with `k = c + h t` and `e^{ixt} = Σ_m ε_m i^m J_m(x) T_m(t)` (`x = ωh`) its
 /// error is `|Σ_{m≥n} ε_m i^m J_m(x) (μ̃_m − μ_m)|`, `μ_m` the weight's Chebyshev moments and
 /// `μ̃_m` the rule's, which on the `n` Chebyshev points are `±μ_r` for the alias `r < n` of `m`
@@ -167,8 +171,16 @@ fn lookup(set: WeightSet, points: usize, omega: f64, ceiling: bool) -> f64 {
         .iter()
         .position(|&r| r >= points)
         .unwrap_or(LADDER.len() - 1);
+    if let Some(stored) = stored_table(set, rung, ceiling) {
+        let i = (omega.abs() / table_step(set, LADDER[rung])).ceil();
+        return if i.is_nan() || i >= FREQUENCIES as f64 {
+            1.0
+        } else {
+            stored.at(i as usize)
+        };
+    }
     let (step, table) = TABLES[set.index()][rung][usize::from(ceiling)]
-        .get_or_init(|| error_table(set, LADDER[rung], ceiling));
+        .get_or_init(|| error_table(set, LADDER[rung], ceiling, moments(set)));
     let i = (omega.abs() / step).ceil();
     if i.is_nan() || i >= table.len() as f64 {
         1.0
@@ -177,12 +189,121 @@ fn lookup(set: WeightSet, points: usize, omega: f64, ceiling: bool) -> f64 {
     }
 }
 
+/// The frequency step of the error tables of `n` points of `set`.
+fn table_step(set: WeightSet, n: usize) -> f64 {
+    let (lo, hi) = support(set);
+    PHASE_PER_POINT * n as f64 / (0.5 * (hi - lo)) / FREQUENCIES as f64
+}
+
+/// The tables a first query would otherwise build (about 140 million instructions of the 174
+/// million of a 130 um rutile plate's first query), computed once by [`tabulate`] and stored in
+/// `chebyshev_tables.bin` (`cargo run --release --example chebyshev_tables` writes it;
+/// `tests::stored_tables_are_current` recomputes it): per weight set, in the order of
+/// [`WeightSet::ALL`], its [`MOMENTS`] Chebyshev moments (three channels each), the rule's own
+/// error table ([`error_bound`]) of every rung up to [`EXACT_RUNGS`] (the only ones
+/// [`smallest_rung`] reads), and the ceiling's ([`error_ceiling`]) of every rung, [`FREQUENCIES`]
+/// values each, and the weights of every rule from 256 points ([`rule`]); `f64`, little-endian.
+static STORED: &[u8] = include_bytes!("chebyshev_tables.bin");
+
+/// Rungs of [`LADDER`] whose rule's own error table is stored.
+const STORED_EXACT: usize = {
+    let mut i = 0;
+    while i < LADDER.len() && LADDER[i] <= EXACT_RUNGS {
+        i += 1;
+    }
+    i
+};
+
+/// The first rung of [`LADDER`] whose rule's weights are stored (from 256 points: below, a rule
+/// costs under a million operations to build, above up to 13 million).
+const STORED_RULES: usize = STORED_EXACT - 1;
+
+/// Where the stored rules start in a set's block, and how many `f64`s they take.
+const RULES_AT: usize = 3 * MOMENTS + (STORED_EXACT + LADDER.len()) * FREQUENCIES;
+const RULES_LEN: usize = {
+    let (mut i, mut len) = (STORED_RULES, 0);
+    while i < LADDER.len() {
+        len += 3 * LADDER[i];
+        i += 1;
+    }
+    len
+};
+
+/// `f64`s stored per weight set.
+const STORED_PER_SET: usize = RULES_AT + RULES_LEN;
+
+/// A run of stored `f64`s.
+#[derive(Clone, Copy)]
+struct Stored(&'static [u8]);
+
+impl Stored {
+    fn at(self, i: usize) -> f64 {
+        let b = &self.0[8 * i..8 * i + 8];
+        f64::from_le_bytes(b.try_into().expect("eight bytes"))
+    }
+}
+
+/// `len` stored values from value `start` of `set`'s block; `None` where the file does not hold
+/// every set's block (while it is being written: then everything is computed).
+fn stored(set: WeightSet, start: usize, len: usize) -> Option<Stored> {
+    if STORED.len() != 8 * STORED_PER_SET * WeightSet::ALL.len() {
+        return None;
+    }
+    let base = 8 * (set.index() * STORED_PER_SET + start);
+    Some(Stored(&STORED[base..base + 8 * len]))
+}
+
+/// The stored error table of `set` at `rung` (the ceiling's with `ceiling`), if stored.
+fn stored_table(set: WeightSet, rung: usize, ceiling: bool) -> Option<Stored> {
+    let index = if ceiling {
+        STORED_EXACT + rung
+    } else if rung < STORED_EXACT {
+        rung
+    } else {
+        return None;
+    };
+    stored(set, 3 * MOMENTS + index * FREQUENCIES, FREQUENCIES)
+}
+
+/// The stored weights of the rule of `set` at `rung` (`3 j + c` for point `j`, channel `c`), if
+/// stored.
+fn stored_rule(set: WeightSet, rung: usize) -> Option<Stored> {
+    if rung < STORED_RULES {
+        return None;
+    }
+    let start = RULES_AT + LADDER[STORED_RULES..rung].iter().sum::<usize>() * 3;
+    stored(set, start, 3 * LADDER[rung])
+}
+
+/// What `chebyshev_tables.bin` holds ([`STORED`]), computed: the moments from the weights' fits
+/// ([`computed_moments`]) and the error tables from them ([`error_table`]).
+#[doc(hidden)]
+pub fn tabulate() -> Vec<u8> {
+    let mut out = Vec::with_capacity(8 * STORED_PER_SET * WeightSet::ALL.len());
+    for set in WeightSet::ALL {
+        let mu = computed_moments(set);
+        let values = mu
+            .iter()
+            .flatten()
+            .copied()
+            .chain((0..STORED_EXACT).flat_map(|r| error_table(set, LADDER[r], false, &mu).1))
+            .chain((0..LADDER.len()).flat_map(|r| error_table(set, LADDER[r], true, &mu).1))
+            .chain((STORED_RULES..LADDER.len()).flat_map(|r| {
+                let w = rule_weights(LADDER[r], &mu);
+                (0..LADDER[r]).flat_map(move |j| [w[0][j], w[1][j], w[2][j]])
+            }));
+        for v in values {
+            out.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    out
+}
+
 /// The table of [`error_bound`] (or, with `ceiling`, of [`error_ceiling`]) for `n` points: its
 /// frequency step and the running maximum of the error (or the bound) at each multiple of it.
-fn error_table(set: WeightSet, n: usize, ceiling: bool) -> (f64, Vec<f64>) {
+fn error_table(set: WeightSet, n: usize, ceiling: bool, mu: &[[f64; 3]]) -> (f64, Vec<f64>) {
     let (lo, hi) = support(set);
     let h = 0.5 * (hi - lo);
-    let mu = moments(set);
     // d_m = μ̃_m − μ_m per channel.
     let d: Vec<[f64; 3]> = (0..MOMENTS)
         .map(|m| {
@@ -196,7 +317,7 @@ fn error_table(set: WeightSet, n: usize, ceiling: bool) -> (f64, Vec<f64>) {
             std::array::from_fn(|c| if m < n { 0.0 } else { alias[c] - mu[m][c] })
         })
         .collect();
-    let step = PHASE_PER_POINT * n as f64 / h / FREQUENCIES as f64;
+    let step = table_step(set, n);
     let mut below = vec![[0.0; 3]; MOMENTS + 1];
     if ceiling {
         for m in 0..MOMENTS {
@@ -356,29 +477,11 @@ pub fn rule(set: WeightSet, points: usize) -> &'static Rule {
     RULES[set.index()][rung].get_or_init(|| {
         let (lo, hi) = support(set);
         let n = LADDER[rung];
-        let mu = moments(set);
-        // W_cj = Σ_m (2 − δ_m0)/N T_m(t_j) μ_cm, T_m(t_j) by the recurrence (stable on
-        // [−1, 1]), a whole column of points per degree (channel by channel: contiguous loops).
-        let t: Vec<f64> = (0..n)
-            .map(|j| (std::f64::consts::PI * (j as f64 + 0.5) / n as f64).cos())
-            .collect();
-        let mut w = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
-        let (mut previous, mut current) = (vec![1.0; n], t.clone());
-        for (c, wc) in w.iter_mut().enumerate() {
-            wc.iter_mut().for_each(|x| *x = mu[0][c] / n as f64);
-        }
-        for moment in &mu[1..n] {
-            for (c, wc) in w.iter_mut().enumerate() {
-                let scale = 2.0 / n as f64 * moment[c];
-                for (x, tm) in wc.iter_mut().zip(&current) {
-                    *x += scale * tm;
-                }
-            }
-            for ((p, q), tj) in previous.iter_mut().zip(current.iter_mut()).zip(&t) {
-                let next = 2.0 * tj * *q - *p;
-                (*p, *q) = (*q, next);
-            }
-        }
+        let t = points_on_interval(n);
+        let w = match stored_rule(set, rung) {
+            Some(s) => std::array::from_fn(|c| (0..n).map(|j| s.at(3 * j + c)).collect()),
+            None => rule_weights(n, moments(set)),
+        };
         let nodes: Vec<(f64, [f64; 3])> = (0..n)
             .map(|j| {
                 let k = 0.5 * (lo + hi) + 0.5 * (hi - lo) * t[j];
@@ -395,6 +498,38 @@ pub fn rule(set: WeightSet, points: usize) -> &'static Rule {
     })
 }
 
+/// The `n` Chebyshev points `t_j = cos(π (j + ½)/n)` on `[−1, 1]`.
+fn points_on_interval(n: usize) -> Vec<f64> {
+    (0..n)
+        .map(|j| (std::f64::consts::PI * (j as f64 + 0.5) / n as f64).cos())
+        .collect()
+}
+
+/// The weights `W_cj` of the rule of `n` points from the moments `mu`, per channel.
+fn rule_weights(n: usize, mu: &[[f64; 3]]) -> [Vec<f64>; 3] {
+    // W_cj = Σ_m (2 − δ_m0)/N T_m(t_j) μ_cm, T_m(t_j) by the recurrence (stable on
+    // [−1, 1]), a whole column of points per degree (channel by channel: contiguous loops).
+    let t = points_on_interval(n);
+    let mut w = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
+    let (mut previous, mut current) = (vec![1.0; n], t.clone());
+    for (c, wc) in w.iter_mut().enumerate() {
+        wc.iter_mut().for_each(|x| *x = mu[0][c] / n as f64);
+    }
+    for moment in &mu[1..n] {
+        for (c, wc) in w.iter_mut().enumerate() {
+            let scale = 2.0 / n as f64 * moment[c];
+            for (x, tm) in wc.iter_mut().zip(&current) {
+                *x += scale * tm;
+            }
+        }
+        for ((p, q), tj) in previous.iter_mut().zip(current.iter_mut()).zip(&t) {
+            let next = 2.0 * tj * *q - *p;
+            (*p, *q) = (*q, next);
+        }
+    }
+    w
+}
+
 /// The Chebyshev moments `μ_cn = ∫ w_c(k) T_n(t(k)) dk` of a weight set on its support,
 /// `n < `[`MOMENTS`], computed once: the weight `f_c(t) = h w_c(c + h t)` (`h` the half width)
 /// is expanded in its Chebyshev series ([`SERIES`] terms) from [`SAMPLES`] samples on Chebyshev
@@ -403,42 +538,52 @@ pub fn rule(set: WeightSet, points: usize) -> &'static Rule {
 /// a few hundred coefficients of the support; `tests::moments_are_converged`), and
 /// `μ_n = Σ_j a_j ∫ T_j T_n dt` with `∫_{−1}^{1} T_j T_n = (I_{j+n} + I_{|j−n|})/2`,
 /// `I_m = 2/(1 − m²)` for even `m`, 0 for odd.
+///
+/// Read from [`STORED`] (computed there by [`computed_moments`]).
 fn moments(set: WeightSet) -> &'static [[f64; 3]] {
     const SETS: usize = WeightSet::ALL.len();
     static MOMENTS_OF: [OnceLock<Vec<[f64; 3]>>; SETS] = [const { OnceLock::new() }; SETS];
-    MOMENTS_OF[set.index()].get_or_init(|| {
-        let a = series(set);
-        // ∫ T_m = 2/(1 − m²) for even m, 0 for odd m.
-        let integral: Vec<f64> = (0..SERIES + MOMENTS)
-            .map(|m| {
-                if m % 2 == 1 {
-                    0.0
-                } else {
-                    2.0 / (1.0 - (m * m) as f64)
-                }
-            })
-            .collect();
-        // μ_cn = ½ Σ_j a_jc (I_{j+n} + I_{|j−n|}) over the j of n's parity (the others vanish),
-        // channel by channel over contiguous slices.
-        let column = |c: usize, parity: usize| -> Vec<f64> {
-            a.iter().skip(parity).step_by(2).map(|x| x[c]).collect()
-        };
-        let columns: [[Vec<f64>; 3]; 2] = [0, 1].map(|p| [0, 1, 2].map(|c| column(c, p)));
-        let mut mu = vec![[0.0; 3]; MOMENTS];
-        let mut kernel = vec![0.0; SERIES.div_ceil(2)];
-        for (n, m) in mu.iter_mut().enumerate() {
-            let parity = n % 2;
-            let cols = &columns[parity];
-            for (i, k) in kernel.iter_mut().enumerate().take(cols[0].len()) {
-                let j = 2 * i + parity;
-                *k = 0.5 * (integral[j + n] + integral[j.abs_diff(n)]);
-            }
-            for (mc, col) in m.iter_mut().zip(cols) {
-                *mc = dot(col, &kernel[..col.len()]);
-            }
-        }
-        mu
+    MOMENTS_OF[set.index()].get_or_init(|| match stored(set, 0, 3 * MOMENTS) {
+        Some(s) => (0..MOMENTS)
+            .map(|m| std::array::from_fn(|c| s.at(3 * m + c)))
+            .collect(),
+        None => computed_moments(set),
     })
+}
+
+/// The moments of [`moments`], computed from the weights' fits.
+fn computed_moments(set: WeightSet) -> Vec<[f64; 3]> {
+    let a = series(set);
+    // ∫ T_m = 2/(1 − m²) for even m, 0 for odd m.
+    let integral: Vec<f64> = (0..SERIES + MOMENTS)
+        .map(|m| {
+            if m % 2 == 1 {
+                0.0
+            } else {
+                2.0 / (1.0 - (m * m) as f64)
+            }
+        })
+        .collect();
+    // μ_cn = ½ Σ_j a_jc (I_{j+n} + I_{|j−n|}) over the j of n's parity (the others vanish),
+    // channel by channel over contiguous slices.
+    let column = |c: usize, parity: usize| -> Vec<f64> {
+        a.iter().skip(parity).step_by(2).map(|x| x[c]).collect()
+    };
+    let columns: [[Vec<f64>; 3]; 2] = [0, 1].map(|p| [0, 1, 2].map(|c| column(c, p)));
+    let mut mu = vec![[0.0; 3]; MOMENTS];
+    let mut kernel = vec![0.0; SERIES.div_ceil(2)];
+    for (n, m) in mu.iter_mut().enumerate() {
+        let parity = n % 2;
+        let cols = &columns[parity];
+        for (i, k) in kernel.iter_mut().enumerate().take(cols[0].len()) {
+            let j = 2 * i + parity;
+            *k = 0.5 * (integral[j + n] + integral[j.abs_diff(n)]);
+        }
+        for (mc, col) in m.iter_mut().zip(cols) {
+            *mc = dot(col, &kernel[..col.len()]);
+        }
+    }
+    mu
 }
 
 /// `Σ x_i y_i` with four partial sums (so that the loop vectorises).
@@ -638,6 +783,40 @@ mod tests {
                 }
             }
             assert!(worst < 1e-13, "{set:?}: {worst:e}");
+        }
+    }
+
+    /// `chebyshev_tables.bin` is what [`tabulate`] computes now (bit for bit where the same
+    /// arithmetic and `libm` built it; within 1e-12 of each value elsewhere), so the stored tables
+    /// are the rules' own and the first query reads them instead of building them.
+    #[test]
+    fn stored_tables_are_current() {
+        let now = tabulate();
+        assert_eq!(
+            now.len(),
+            STORED.len(),
+            "chebyshev_tables.bin is stale: cargo run --release --example chebyshev_tables"
+        );
+        let value = |b: &[u8]| f64::from_le_bytes(b.try_into().unwrap());
+        let (mut differ, mut worst) = (0, 0.0f64);
+        for (a, b) in now.chunks_exact(8).zip(STORED.chunks_exact(8)) {
+            let (a, b) = (value(a), value(b));
+            if a.to_bits() != b.to_bits() {
+                differ += 1;
+                worst = worst.max((a - b).abs() / a.abs().max(1e-300));
+            }
+            assert!(
+                (a - b).abs() <= 1e-12 * a.abs() + 1e-18,
+                "chebyshev_tables.bin is stale ({a:e} stored as {b:e}): cargo run --release --example chebyshev_tables"
+            );
+        }
+        println!(
+            "{} values, {differ} not bit for bit (largest relative difference {worst:e})",
+            now.len() / 8
+        );
+        // What the first query reads is what it would otherwise build.
+        for set in WeightSet::ALL {
+            assert!(moments(set) == computed_moments(set).as_slice() || differ > 0);
         }
     }
 
