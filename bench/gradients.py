@@ -20,11 +20,12 @@ gradient enabled the parameter is an input of the plate's program instead of a c
    (`time.process_time`: every thread of the process, less sensitive to other processes on a
    shared machine than the wall time, which is recorded too) and the ratios to the primal
    render's.
-2. **Peak memory.** One process per configuration loads the scene, renders once (kernel
-   compilation), resets the kernel's high-water mark of its resident set (`/proc/self/clear_refs`)
-   and renders twice more: the figure is that peak (`VmHWM`) over the resident set before the
-   renders, i.e. what the renders themselves hold at their peak (the process's own start, Python,
-   Mitsuba and Dr.Jit's LLVM back end, is ~650 MiB, larger than any render here).
+2. **Peak memory.** One process per configuration loads the scene, resets the kernel's
+   high-water mark of its resident set (`/proc/self/clear_refs`) and renders three times (the
+   first compiles the kernels): the figure is that peak (`VmHWM`) over the resident set after
+   loading, i.e. what the renders and their compilation hold at their peak (Dr.Jit keeps the
+   memory of one render for the next: measured after a first render, the peak of later ones
+   over it was 0).
 
 Writes ``bench/out/gradients.json`` and prints the table with the machine's load.
 """
@@ -120,11 +121,10 @@ def peak_memory(index: int, size: int, spp: int) -> None:
 
     scene, params = load(size, spp)
     _, key, mode = RUNS[index]
-    run_one(scene, params, key, mode, spp)
     gc.collect()
     before = status_kib("VmRSS")
     pathlib.Path("/proc/self/clear_refs").write_text("5")  # resets VmHWM
-    for _ in range(2):
+    for _ in range(3):
         run_one(scene, params, key, mode, spp)
     peak = status_kib("VmHWM")
     print(RESULT + json.dumps(max(0, peak - before)))
