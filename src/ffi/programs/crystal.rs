@@ -1,16 +1,14 @@
 //! The program of a `birefringent` crystal surface's sample.
 
-use super::{core_transport, outputs, Program};
+use super::{channel_count, core_transport, output, outputs, Program};
 use crate::error::{Error, Result};
 use crate::ffi::bridge::{CrystalInput, CrystalRecipe};
 use crate::ffi::materials::Materials;
 use crate::material::check_clear_index;
 use crate::optics::medium::Uniaxial;
-use crate::plate::slab::Output as Intensity;
 use crate::real::{Mask, Real};
 use crate::record::{self, Output, Var};
 use crate::render::crystal::{sample_exact, ExactCrystal};
-use crate::render::thin::MAX_BANDS;
 use crate::render::Transport;
 use crate::C64;
 use nalgebra::Vector3;
@@ -20,13 +18,7 @@ use nalgebra::Vector3;
 pub fn record_crystal(materials: &Materials, recipe: &CrystalRecipe) -> Result<Box<Program>> {
     let material = *materials.get(recipe.material)?;
     let transport = core_transport(recipe.transport)?;
-    let channels = recipe.channels as usize;
-    if !(1..=MAX_BANDS).contains(&channels) {
-        return Err(Error::new(
-            "channels",
-            format!("must be 1 to {MAX_BANDS}, got {channels}"),
-        ));
-    }
+    let channels = channel_count(recipe.channels)?;
     let ext = check_clear_index("ext_ior", C64::new(recipe.ext_ior, 0.0))?.re;
     if recipe.kappas_are_inputs && !material.is_isotropic() {
         return Err(Error::new(
@@ -80,11 +72,7 @@ pub fn record_crystal(materials: &Materials, recipe: &CrystalRecipe) -> Result<B
             material,
             ext: Var::cst(ext),
             axis: invalid.when(|| Vector3::new(zero, zero, one), || axis),
-            output: if recipe.intensity_only {
-                Intensity::Intensity
-            } else {
-                Intensity::Mueller
-            },
+            output: output(recipe.intensity_only),
         };
         let wi = Vector3::new(
             input(CrystalInput::WiX),

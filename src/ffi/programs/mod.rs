@@ -15,6 +15,7 @@ pub use stack::record_stack;
 
 use super::bridge::{Instr, Op as BridgeOp, SampleOutput, Transport};
 use crate::error::{Error, Result};
+use crate::plate::slab::{Output as Intensity, Want};
 use crate::real::{Mask, Real};
 use crate::record::{self, Op, Output, Var};
 use crate::render::choice::Sampled;
@@ -92,6 +93,37 @@ pub(super) fn outputs<const C: usize>(s: &Sampled<Var, C>) -> Result<Vec<Output>
 }
 
 /// The core's transport mode.
+/// The number of exact wavelengths a recipe asks for, checked once (1 to [`MAX_BANDS`]).
+pub(super) fn channel_count(channels: u32) -> Result<usize> {
+    let channels = channels as usize;
+    if (1..=MAX_BANDS).contains(&channels) {
+        Ok(channels)
+    } else {
+        Err(Error::new(
+            "channels",
+            format!("must be 1 to {MAX_BANDS}, got {channels}"),
+        ))
+    }
+}
+
+/// The lobes of a thin element a recipe's `components` bits ask for (bit 0 reflection, bit 1
+/// transmission).
+pub(super) fn wanted(components: u32) -> Want {
+    Want {
+        reflection: components & 1 != 0,
+        transmission: components & 2 != 0,
+    }
+}
+
+/// Only `M00` (an unpolarized variant) or the whole Mueller matrix.
+pub(super) fn output(intensity_only: bool) -> Intensity {
+    if intensity_only {
+        Intensity::Intensity
+    } else {
+        Intensity::Mueller
+    }
+}
+
 pub(super) fn core_transport(t: Transport) -> Result<CoreTransport> {
     match t {
         Transport::Radiance => Ok(CoreTransport::Radiance),

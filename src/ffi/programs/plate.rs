@@ -1,18 +1,16 @@
 //! The program of a `thinbirefringent` plate's sample.
 
 use super::layer::{recorded_layer, Param, Settings};
-use super::{core_transport, outputs, Program};
-use crate::error::{Error, Result};
+use super::{channel_count, core_transport, output, outputs, wanted, Program};
+use crate::error::Result;
 use crate::ffi::bridge::{PlateInput, PlateRecipe};
 use crate::ffi::materials::Materials;
 use crate::material::Material;
-use crate::plate::slab::{Output as Intensity, Want};
 use crate::plate::Plate;
 use crate::real::complex::Cx;
 use crate::real::Real;
 use crate::record::{self, Var};
 use crate::render::plate::{sample_exact, ExactPlate};
-use crate::render::thin::MAX_BANDS;
 use nalgebra::Vector3;
 
 /// Records the sample of a `thinbirefringent` plate over `recipe.channels` exact wavelengths
@@ -20,13 +18,7 @@ use nalgebra::Vector3;
 pub fn record_plate(materials: &Materials, recipe: &PlateRecipe) -> Result<Box<Program>> {
     let material = *materials.get(recipe.material)?;
     let transport = core_transport(recipe.transport)?;
-    let channels = recipe.channels as usize;
-    if !(1..=MAX_BANDS).contains(&channels) {
-        return Err(Error::new(
-            "channels",
-            format!("must be 1 to {MAX_BANDS}, got {channels}"),
-        ));
-    }
+    let channels = channel_count(recipe.channels)?;
     let inputs = PlateInput::Wavelength0.repr as usize + channels;
     let p = record::record(inputs, |x| {
         let input = |k: PlateInput| x[k.repr as usize];
@@ -119,15 +111,8 @@ fn recorded_plate(
             axis: layer.axis,
             thickness_nm: layer.thickness_nm,
         },
-        want: Want {
-            reflection: recipe.components & 1 != 0,
-            transmission: recipe.components & 2 != 0,
-        },
-        output: if recipe.intensity_only {
-            Intensity::Intensity
-        } else {
-            Intensity::Mueller
-        },
+        want: wanted(recipe.components),
+        output: output(recipe.intensity_only),
         absorbing_exit: recipe.absorbing_exit,
     })
 }

@@ -2,17 +2,15 @@
 //! ([`super::layer`]), and the path's.
 
 use super::layer::{recorded_layer, Param, Settings};
-use super::{core_transport, outputs, Program};
+use super::{channel_count, core_transport, output, outputs, wanted, Program};
 use crate::error::{Error, Result};
 use crate::ffi::bridge::{StackInput, StackLayerInput, StackLayerRecipe, StackRecipe};
 use crate::ffi::materials::Materials;
 use crate::material::check_clear_index;
-use crate::plate::slab::{Output as Intensity, Want};
 use crate::real::complex::Cx;
 use crate::real::{Mask, Real};
 use crate::record::{self, Flag, Output, Var};
 use crate::render::stack::{sample_exact_stack, ExactStack};
-use crate::render::thin::MAX_BANDS;
 use crate::render::Transport;
 use crate::stack::{in_layer, Stack};
 use crate::C64;
@@ -23,13 +21,7 @@ use nalgebra::Vector3;
 /// `layers[k].material`.
 pub fn record_stack(materials: &Materials, recipe: &StackRecipe) -> Result<Box<Program>> {
     let transport = core_transport(recipe.transport)?;
-    let channels = recipe.channels as usize;
-    if !(1..=MAX_BANDS).contains(&channels) {
-        return Err(Error::new(
-            "channels",
-            format!("must be 1 to {MAX_BANDS}, got {channels}"),
-        ));
-    }
+    let channels = channel_count(recipe.channels)?;
     if recipe.layers.is_empty() {
         return Err(Error::new("layers", "a stack needs at least one layer"));
     }
@@ -65,15 +57,8 @@ pub fn record_stack(materials: &Materials, recipe: &StackRecipe) -> Result<Box<P
                 exit: real(exit),
             },
             below: Flag::cst(false),
-            want: Want {
-                reflection: recipe.components & 1 != 0,
-                transmission: recipe.components & 2 != 0,
-            },
-            output: if recipe.intensity_only {
-                Intensity::Intensity
-            } else {
-                Intensity::Mueller
-            },
+            want: wanted(recipe.components),
+            output: output(recipe.intensity_only),
             absorbing_exit: recipe.absorbing_exit,
         };
         let path = |k: StackInput| x[k.repr as usize];
