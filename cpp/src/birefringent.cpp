@@ -362,9 +362,8 @@ private:
         Vector3f axis = m_diff.optic_axis();
         if (m_axis_in_world)
             axis = si.to_local(axis);
-        bool axis_input = m_axis_in_world || dr::grad_enabled(axis);
-        bool indices_input = !m_diff.material.named && dr::grad_enabled(eta_o, eta_e);
-        bool kappas_input = dr::grad_enabled(kappa_o, kappa_e);
+        auto [axis_grad, indices_input, kappas_input] = m_diff.program_inputs();
+        bool axis_input = m_axis_in_world || axis_grad;
         ProgramKey key{ radiance, components, axis_input, indices_input, kappas_input };
         const bfr::Program &program = m_programs.get(key, [&] {
             const ScalarVector3f &a = m_diff.axis;

@@ -428,10 +428,8 @@ private:
         std::vector<uint8_t> inputs;
         for (size_t k = 0; k < n_layers; ++k) {
             Layer l = m_sources[k]->layer();
-            const auto &d = *l.diff;
-            inputs.push_back((dr::grad_enabled(d.optic_axis()) ? 1 : 0) |
-                             (!l.material->named && dr::grad_enabled(d.eta_o(), d.eta_e()) ? 2 : 0) |
-                             (dr::grad_enabled(d.kappa_o(), d.kappa_e()) ? 4 : 0));
+            auto [axis, indices, kappas] = l.diff->program_inputs();
+            inputs.push_back((axis ? 1 : 0) | (indices ? 2 : 0) | (kappas ? 4 : 0));
             layers.push_back(l);
         }
         ProgramKey key{ radiance, components, inputs };

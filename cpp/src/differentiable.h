@@ -121,6 +121,18 @@ public:
             return Vector3f(axis);
     }
 
+    /// Which parameters a recorded program reads per lane instead of folding them in as
+    /// constants: those that carry gradients (a named crystal's indices are its dispersion fit,
+    /// never inputs). The one decision for the programs of every plugin.
+    struct Inputs {
+        bool axis, indices, kappas;
+    };
+    Inputs program_inputs() const {
+        return { dr::grad_enabled(optic_axis()),
+                 !material.named && dr::grad_enabled(eta_o(), eta_e()),
+                 dr::grad_enabled(kappa_o(), kappa_e()) };
+    }
+
 private:
     static float host(const Float &x) {
         if constexpr (Jit)

@@ -505,9 +505,7 @@ private:
         Float eta_o = m_diff.eta_o(), eta_e = m_diff.eta_e(), kappa_o = m_diff.kappa_o(),
               kappa_e = m_diff.kappa_e();
         Vector3f axis = m_diff.optic_axis();
-        bool axis_input = dr::grad_enabled(axis);
-        bool indices_input = !m_diff.material.named && dr::grad_enabled(eta_o, eta_e);
-        bool kappas_input = dr::grad_enabled(kappa_o, kappa_e);
+        auto [axis_input, indices_input, kappas_input] = m_diff.program_inputs();
         ProgramKey key{ radiance, components, axis_input, indices_input, kappas_input };
         const bfr::Program &program = m_programs.get(key, [&] {
             const ScalarVector3f &a = m_diff.axis;
